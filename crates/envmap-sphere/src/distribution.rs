@@ -1,0 +1,199 @@
+//! Importance sampling of a map in pbrt's style: piecewise-constant 1D and 2D distributions,
+//! and [`EnvDistribution`] with its `sample_dir` / `dir_pdf` / `invert_dir_sample` triple.
+//!
+//! Each texel gets probability proportional to luminance x solid angle, and a sample is
+//! uniform *in solid angle* within its texel (uniform in phi and in cos theta), so the pdf
+//! with respect to solid angle is exactly Y(texel) / integral(Y d omega), constant per texel,
+//! with no 1/sin theta blow-up at the poles.
+
+use crate::color::luminance;
+use crate::envmap::EnvMap;
+use crate::latlong::row_cos_bounds;
+use glam::{Vec2, Vec3};
+use std::f32::consts::TAU;
+
+/// The largest f32 below one: samples are drawn from [0, 1).
+pub const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// A piecewise-constant distribution over [0, 1) with `n` equal cells.
+#[derive(Clone, Debug)]
+pub struct Distribution1D {
+    func: Vec<f64>,
+    cdf: Vec<f64>,
+    integral: f64,
+}
+
+impl Distribution1D {
+    /// From non-negative cell weights (negative and non-finite weights count as zero).
+    /// All-zero weights give the uniform distribution.
+    ///
+    /// # Panics
+    /// When `weights` is empty.
+    #[must_use]
+    pub fn new(weights: impl IntoIterator<Item = f64>) -> Self {
+        let mut func: Vec<f64> =
+            weights.into_iter().map(|w| if w.is_finite() && w > 0.0 { w } else { 0.0 }).collect();
+        assert!(!func.is_empty(), "a distribution needs at least one cell");
+        let n = func.len() as f64;
+        let mut cdf = Vec::with_capacity(func.len() + 1);
+        cdf.push(0.0);
+        for f in &func {
+            cdf.push(cdf.last().copied().unwrap_or(0.0) + f / n);
+        }
+        let mut integral = cdf[func.len()];
+        if integral <= 0.0 {
+            func.iter_mut().for_each(|f| *f = 1.0);
+            cdf.iter_mut().enumerate().for_each(|(k, c)| *c = k as f64 / n);
+            integral = 0.0;
+        } else {
+            cdf.iter_mut().for_each(|c| *c /= integral);
+        }
+        Self { func, cdf, integral }
+    }
+
+    /// Number of cells.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.func.len()
+    }
+
+    /// Always false: a distribution has at least one cell.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+
+    /// Integral of the weights over [0, 1) (0 for an all-zero distribution).
+    #[must_use]
+    pub fn integral(&self) -> f64 {
+        self.integral
+    }
+
+    /// Probability of cell `k`.
+    #[must_use]
+    pub fn cell_probability(&self, k: usize) -> f64 {
+        self.cdf[k + 1] - self.cdf[k]
+    }
+
+    /// Samples a cell and the position inside it: returns (cell, fraction in [0, 1)).
+    #[must_use]
+    pub fn sample(&self, u: f32) -> (usize, f32) {
+        let u = f64::from(u.clamp(0.0, ONE_MINUS_EPSILON));
+        // last k with cdf[k] <= u, skipping zero-probability cells
+        let k = self.cdf.partition_point(|&c| c <= u).saturating_sub(1).min(self.len() - 1);
+        let p = self.cell_probability(k);
+        let frac = if p > 0.0 { (u - self.cdf[k]) / p } else { 0.0 };
+        (k, (frac as f32).clamp(0.0, ONE_MINUS_EPSILON))
+    }
+
+    /// The `u` that [`Distribution1D::sample`] maps to (cell, fraction).
+    #[must_use]
+    pub fn invert(&self, cell: usize, frac: f32) -> f32 {
+        let p = self.cell_probability(cell);
+        ((self.cdf[cell] + p * f64::from(frac)) as f32).clamp(0.0, ONE_MINUS_EPSILON)
+    }
+}
+
+/// One importance sample of an environment map.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DirSample {
+    /// Unit direction towards the map.
+    pub dir: Vec3,
+    /// Density with respect to solid angle.
+    pub pdf: f32,
+}
+
+/// Luminance importance sampling of a lat-long map.
+///
+/// A black map (or one with no positive luminance) falls back to uniform sampling of the
+/// sphere, pdf 1 / (4 pi), so callers never divide by zero.
+///
+/// ```
+/// use envmap_sphere::{EnvMap, EnvDistribution};
+/// use glam::{Vec2, Vec3};
+/// let map = EnvMap::from_fn(32, 16, |d| Vec3::splat(1.0 + d.y.max(0.0)));
+/// let dist = EnvDistribution::new(&map);
+/// let s = dist.sample_dir(Vec2::new(0.3, 0.7));
+/// assert!((s.pdf - dist.dir_pdf(s.dir)).abs() < 1e-5 * s.pdf);
+/// let u = dist.invert_dir_sample(s.dir);
+/// assert!((u - Vec2::new(0.3, 0.7)).length() < 1e-4);
+/// ```
+#[derive(Clone, Debug)]
+pub struct EnvDistribution {
+    width: u32,
+    height: u32,
+    rows: Distribution1D,
+    cols: Vec<Distribution1D>,
+    /// per texel: pdf with respect to solid angle
+    texel_pdf: Vec<f32>,
+    row_cos: Vec<(f64, f64)>,
+}
+
+impl EnvDistribution {
+    /// Builds the distribution of `map`'s luminance x texel solid angle.
+    #[must_use]
+    pub fn new(map: &EnvMap) -> Self {
+        let (w, h) = (map.width(), map.height());
+        let sa: Vec<f64> = map.row_solid_angles();
+        let lum = |i: u32, j: u32| f64::from(luminance(map.pixel(i, j))).max(0.0);
+        let total: f64 = (0..h).map(|j| (0..w).map(|i| lum(i, j)).sum::<f64>() * sa[j as usize]).sum();
+        let black = !(total.is_finite() && total > 0.0);
+        let weight = |i: u32, j: u32| if black { sa[j as usize] } else { lum(i, j) * sa[j as usize] };
+        let cols: Vec<Distribution1D> =
+            (0..h).map(|j| Distribution1D::new((0..w).map(|i| weight(i, j)))).collect();
+        let rows = Distribution1D::new(cols.iter().map(Distribution1D::integral));
+        let norm = if black { 4.0 * std::f64::consts::PI } else { total };
+        let texel_pdf = (0..h)
+            .flat_map(|j| (0..w).map(move |i| (i, j)))
+            .map(|(i, j)| (weight(i, j) / sa[j as usize] / norm) as f32)
+            .collect();
+        let row_cos = (0..h).map(|j| row_cos_bounds(j, h)).collect();
+        Self { width: w, height: h, rows, cols, texel_pdf, row_cos }
+    }
+
+    /// Probability of choosing texel (i, j).
+    #[must_use]
+    pub fn texel_probability(&self, i: u32, j: u32) -> f64 {
+        self.rows.cell_probability(j as usize) * self.cols[j as usize].cell_probability(i as usize)
+    }
+
+    /// Maps `u` in [0, 1)^2 to a direction and its pdf with respect to solid angle.
+    #[must_use]
+    pub fn sample_dir(&self, u: Vec2) -> DirSample {
+        let (j, t) = self.rows.sample(u.y);
+        let (i, s) = self.cols[j].sample(u.x);
+        let phi = TAU * (i as f32 + s) / self.width as f32;
+        let (c0, c1) = self.row_cos[j];
+        let cos_theta = (c0 + f64::from(t) * (c1 - c0)).clamp(-1.0, 1.0) as f32;
+        let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+        let (sp, cp) = phi.sin_cos();
+        let dir = Vec3::new(sin_theta * sp, cos_theta, -sin_theta * cp);
+        DirSample { dir, pdf: self.texel_pdf[j * self.width as usize + i] }
+    }
+
+    /// Density with respect to solid angle of sampling `dir` (need not be normalized).
+    #[must_use]
+    pub fn dir_pdf(&self, dir: Vec3) -> f32 {
+        let (i, j, _, _) = self.locate(dir);
+        self.texel_pdf[j * self.width as usize + i]
+    }
+
+    /// The `u` that [`EnvDistribution::sample_dir`] maps to `dir`.
+    #[must_use]
+    pub fn invert_dir_sample(&self, dir: Vec3) -> Vec2 {
+        let (i, j, s, t) = self.locate(dir);
+        Vec2::new(self.cols[j].invert(i, s), self.rows.invert(j, t))
+    }
+
+    /// (column, row, fraction in phi, fraction in cos theta) of a direction.
+    fn locate(&self, dir: Vec3) -> (usize, usize, f32, f32) {
+        let d = dir.normalize_or(Vec3::Y);
+        let uv = crate::latlong::latlong_dir_to_uv(d);
+        let x = uv.x * self.width as f32;
+        let i = (x as usize).min(self.width as usize - 1);
+        let j = ((uv.y * self.height as f32) as usize).min(self.height as usize - 1);
+        let (c0, c1) = self.row_cos[j];
+        let t = ((c0 - f64::from(d.y)) / (c0 - c1)).clamp(0.0, 1.0) as f32;
+        (i, j, (x - i as f32).clamp(0.0, ONE_MINUS_EPSILON), t.min(ONE_MINUS_EPSILON))
+    }
+}

@@ -1,0 +1,354 @@
+//! Loading (.exr, Radiance .hdr) with validation, and saving (.exr, tone-mapped .png).
+//!
+//! Files are recognised by magic number, not extension. Every failure is an [`EnvMapError`]
+//! naming the file and the reason. Policies for real-world input:
+//! - size: the header's claimed size is checked against [`LoadOptions::max_pixels`] before any
+//!   pixel buffer is allocated (default 2^27 texels = 16384 x 8192, 1.5 GiB as f32 RGB);
+//! - aspect: a width/height ratio outside [1, 4] is refused as not lat-long; other ratios than
+//!   2:1 load with a warning (the convention works for any W x H, with non-square texels);
+//! - NaN / infinity: an error by default; [`NonFinitePolicy::Zero`] zeroes them and counts them;
+//! - negative values: lossy EXR compression (DWAB) rings slightly below zero; by default they are
+//!   clamped to zero and the count and the fraction of power removed are reported, unless the
+//!   negative power exceeds [`DEFAULT_MAX_NEGATIVE_FRACTION`] of the positive power (a broken
+//!   file). [`NegativePolicy::Strict`] refuses any negative value.
+
+use crate::envmap::EnvMap;
+use crate::error::EnvMapError;
+use crate::tonemap::Tonemap;
+use glam::Vec3;
+use std::io::Cursor;
+use std::path::{Path, PathBuf};
+
+/// Default [`LoadOptions::max_pixels`]: 2^27 texels (16384 x 8192).
+pub const DEFAULT_MAX_PIXELS: u64 = 1 << 27;
+
+/// Default limit on negative power / positive power under [`NegativePolicy::Clamp`]:
+/// 1e-3. DWAB noise in Blender's maps is a few 1e-7 of the power.
+pub const DEFAULT_MAX_NEGATIVE_FRACTION: f64 = 1e-3;
+
+/// What to do with NaN and infinite pixel values.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub enum NonFinitePolicy {
+    /// Refuse the file ([`EnvMapError::NonFinite`]).
+    #[default]
+    Error,
+    /// Replace them by zero and count them in [`LoadReport::non_finite_zeroed`].
+    Zero,
+}
+
+/// What to do with negative pixel values.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum NegativePolicy {
+    /// Clamp to zero, unless the negative power exceeds `max_power_fraction` of the positive.
+    Clamp {
+        /// Largest accepted negative power / positive power.
+        max_power_fraction: f64,
+    },
+    /// Refuse any negative value.
+    Strict,
+}
+
+impl Default for NegativePolicy {
+    fn default() -> Self {
+        Self::Clamp { max_power_fraction: DEFAULT_MAX_NEGATIVE_FRACTION }
+    }
+}
+
+/// Options for [`EnvMap::load_with`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LoadOptions {
+    /// Refuse files whose header claims more texels than this, before allocating.
+    pub max_pixels: u64,
+    /// NaN and infinity handling.
+    pub non_finite: NonFinitePolicy,
+    /// Negative value handling.
+    pub negative: NegativePolicy,
+}
+
+impl Default for LoadOptions {
+    fn default() -> Self {
+        Self {
+            max_pixels: DEFAULT_MAX_PIXELS,
+            non_finite: NonFinitePolicy::default(),
+            negative: NegativePolicy::default(),
+        }
+    }
+}
+
+/// File format of a loaded map.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FileFormat {
+    /// OpenEXR.
+    Exr,
+    /// Radiance RGBE.
+    Hdr,
+}
+
+impl FileFormat {
+    /// "exr" or "hdr".
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Exr => "exr",
+            Self::Hdr => "hdr",
+        }
+    }
+}
+
+/// What loading found and changed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoadReport {
+    /// The file format.
+    pub format: FileFormat,
+    /// Compression, lower case: "none", "rle", "zip", "zip16", "piz", "pxr24", "b44", "b44a",
+    /// "dwaa", "dwab" for EXR; "rle" for Radiance (adaptive run-length).
+    pub compression: String,
+    /// Negative channel values clamped to zero.
+    pub negatives_clamped: usize,
+    /// Power removed by clamping, as a fraction of the positive power (sum over channels).
+    pub negative_power_fraction: f64,
+    /// NaN or infinite channel values zeroed under [`NonFinitePolicy::Zero`].
+    pub non_finite_zeroed: usize,
+    /// Human-readable warnings (e.g. an aspect ratio other than 2:1).
+    pub warnings: Vec<String>,
+}
+
+impl EnvMap {
+    /// Loads an .exr or Radiance .hdr file with default [`LoadOptions`].
+    ///
+    /// # Errors
+    /// See [`EnvMap::load_with`].
+    pub fn load(path: impl AsRef<Path>) -> Result<Self, EnvMapError> {
+        Self::load_with(path, &LoadOptions::default()).map(|(map, _)| map)
+    }
+
+    /// Loads an .exr or Radiance .hdr file, applying `options`, and reports what it changed.
+    ///
+    /// # Errors
+    /// Any [`EnvMapError`] file variant: unreadable, empty, unknown format, undecodable, too
+    /// large, zero-sized, not lat-long, non-finite or negative values against the policy.
+    pub fn load_with(path: impl AsRef<Path>, options: &LoadOptions) -> Result<(Self, LoadReport), EnvMapError> {
+        let path = path.as_ref();
+        let bytes = std::fs::read(path).map_err(|e| EnvMapError::io(path, e))?;
+        Self::load_from_bytes(&bytes, path, options)
+    }
+
+    /// Loads a map from the bytes of an .exr or .hdr file; `name` is used in errors.
+    ///
+    /// # Errors
+    /// As [`EnvMap::load_with`].
+    pub fn load_from_bytes(
+        bytes: &[u8],
+        name: impl AsRef<Path>,
+        options: &LoadOptions,
+    ) -> Result<(Self, LoadReport), EnvMapError> {
+        let path = name.as_ref().to_path_buf();
+        if bytes.is_empty() {
+            return Err(EnvMapError::Empty { path });
+        }
+        let (width, height, mut pixels, format, compression) = if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
+            decode_exr(bytes, &path, options)?
+        } else if bytes.starts_with(b"#?") {
+            decode_hdr(bytes, &path, options)?
+        } else {
+            return Err(EnvMapError::UnknownFormat { path });
+        };
+        let mut report = LoadReport {
+            format,
+            compression,
+            negatives_clamped: 0,
+            negative_power_fraction: 0.0,
+            non_finite_zeroed: 0,
+            warnings: Vec::new(),
+        };
+        if width != 2 * height {
+            report.warnings.push(format!(
+                "{}: {width} x {height} is not 2:1; read as lat-long with non-square texels",
+                path.display()
+            ));
+        }
+        sanitize(&mut pixels, width, height, &path, options, &mut report)?;
+        let map = Self::try_new(width, height, pixels).map_err(|_| EnvMapError::InvalidSize {
+            path: path.clone(),
+            width: u64::from(width),
+            height: u64::from(height),
+        })?;
+        Ok((map, report))
+    }
+
+    /// Saves as a lossless (ZIP) 32-bit float RGB OpenEXR file.
+    ///
+    /// # Errors
+    /// [`EnvMapError::Encode`] when the file cannot be written.
+    pub fn save_exr(&self, path: impl AsRef<Path>) -> Result<(), EnvMapError> {
+        save_exr_rgb(path.as_ref(), self.width() as usize, self.height() as usize, self.pixels())
+    }
+
+    /// Saves a tone-mapped 8-bit sRGB preview (.png) with [`Tonemap::auto`].
+    ///
+    /// # Errors
+    /// [`EnvMapError::Encode`] when the file cannot be written.
+    pub fn save_png_preview(&self, path: impl AsRef<Path>) -> Result<(), EnvMapError> {
+        let tm = Tonemap::auto(self.pixels());
+        save_png_rgb(path.as_ref(), self.width(), self.height(), self.pixels(), &tm)
+    }
+}
+
+/// Writes row-major linear RGB as a ZIP-compressed float OpenEXR file.
+///
+/// # Errors
+/// [`EnvMapError::Encode`] when the file cannot be written.
+pub fn save_exr_rgb(path: &Path, width: usize, height: usize, pixels: &[Vec3]) -> Result<(), EnvMapError> {
+    use exr::prelude::*;
+    let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
+        let c = pixels[p.y() * width + p.x()];
+        (c.x, c.y, c.z)
+    });
+    let layer = Layer::new((width, height), LayerAttributes::named("rgb"), Encoding::SMALL_LOSSLESS, channels);
+    Image::from_layer(layer)
+        .write()
+        .to_file(path)
+        .map_err(|e| EnvMapError::Encode { path: path.to_path_buf(), format: "OpenEXR", reason: e.to_string() })
+}
+
+/// Writes row-major linear RGB as an 8-bit sRGB PNG through `tonemap`.
+///
+/// # Errors
+/// [`EnvMapError::Encode`] when the file cannot be written.
+pub fn save_png_rgb(path: &Path, width: u32, height: u32, pixels: &[Vec3], tonemap: &Tonemap) -> Result<(), EnvMapError> {
+    let bytes: Vec<u8> = pixels.iter().flat_map(|p| tonemap.apply(*p)).collect();
+    image::save_buffer_with_format(path, &bytes, width, height, image::ExtendedColorType::Rgb8, image::ImageFormat::Png)
+        .map_err(|e| EnvMapError::Encode { path: path.to_path_buf(), format: "PNG", reason: e.to_string() })
+}
+
+type Decoded = (u32, u32, Vec<Vec3>, FileFormat, String);
+
+fn check_size(path: &Path, w: u64, h: u64, options: &LoadOptions) -> Result<(u32, u32), EnvMapError> {
+    let path = path.to_path_buf();
+    if w == 0 || h == 0 {
+        return Err(EnvMapError::InvalidSize { path, width: w, height: h });
+    }
+    if w.saturating_mul(h) > options.max_pixels || w > u64::from(u32::MAX) || h > u64::from(u32::MAX) {
+        return Err(EnvMapError::TooLarge { path, width: w, height: h, limit: options.max_pixels });
+    }
+    if w < h || w > 4 * h {
+        return Err(EnvMapError::NotLatLong { path, width: w, height: h });
+    }
+    Ok((w as u32, h as u32))
+}
+
+fn decode_exr(bytes: &[u8], path: &Path, options: &LoadOptions) -> Result<Decoded, EnvMapError> {
+    use exr::prelude::*;
+    let err = |reason: String| EnvMapError::Decode { path: path.to_path_buf(), format: "OpenEXR", reason };
+    let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false).map_err(|e| err(e.to_string()))?;
+    let header = meta.headers.first().ok_or_else(|| err("no layers".into()))?;
+    let size = header.layer_size;
+    let (w, h) = check_size(path, size.width() as u64, size.height() as u64, options)?;
+    let compression = format!("{:?}", header.compression);
+    let compression = compression.split('(').next().unwrap_or("").to_lowercase();
+    let compression = if compression == "uncompressed" { "none".to_string() } else { compression };
+    let has = |name: &str| header.channels.list.iter().any(|c| c.name.eq(name));
+    if !(has("R") && has("G") && has("B")) {
+        let names: Vec<String> = header.channels.list.iter().map(|c| c.name.to_string()).collect();
+        return Err(err(format!("no R, G, B channels (has {})", names.join(", "))));
+    }
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .rgba_channels(
+            |res, _| vec![Vec3::ZERO; res.width() * res.height()],
+            move |px: &mut Vec<Vec3>, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+                px[pos.y() * w as usize + pos.x()] = Vec3::new(r, g, b);
+            },
+        )
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(Cursor::new(bytes))
+        .map_err(|e| err(e.to_string()))?;
+    let pixels = image.layer_data.channel_data.pixels;
+    if pixels.len() != w as usize * h as usize {
+        return Err(err(format!("decoded {} pixels for {w} x {h}", pixels.len())));
+    }
+    Ok((w, h, pixels, FileFormat::Exr, compression))
+}
+
+fn decode_hdr(bytes: &[u8], path: &Path, options: &LoadOptions) -> Result<Decoded, EnvMapError> {
+    use image::ImageDecoder;
+    let err = |reason: String| EnvMapError::Decode { path: path.to_path_buf(), format: "Radiance HDR", reason };
+    let decoder = image::codecs::hdr::HdrDecoder::new(Cursor::new(bytes)).map_err(|e| err(e.to_string()))?;
+    let (w, h) = decoder.dimensions();
+    let (w, h) = check_size(path, u64::from(w), u64::from(h), options)?;
+    let mut buf = vec![0u8; decoder.total_bytes() as usize];
+    decoder.read_image(&mut buf).map_err(|e| err(e.to_string()))?;
+    let pixels = buf
+        .chunks_exact(12)
+        .map(|c| {
+            let f = |k: usize| f32::from_ne_bytes([c[k], c[k + 1], c[k + 2], c[k + 3]]);
+            Vec3::new(f(0), f(4), f(8))
+        })
+        .collect();
+    Ok((w, h, pixels, FileFormat::Hdr, "rle".into()))
+}
+
+/// Applies the non-finite and negative policies in place.
+fn sanitize(
+    pixels: &mut [Vec3],
+    width: u32,
+    height: u32,
+    path: &Path,
+    options: &LoadOptions,
+    report: &mut LoadReport,
+) -> Result<(), EnvMapError> {
+    let path: PathBuf = path.to_path_buf();
+    let non_finite: Vec<usize> =
+        pixels.iter().enumerate().filter(|(_, p)| !p.is_finite()).map(|(k, _)| k).collect();
+    if let Some(&first) = non_finite.first() {
+        let count: usize = non_finite.iter().map(|&k| (0..3).filter(|&c| !pixels[k][c].is_finite()).count()).sum();
+        match options.non_finite {
+            NonFinitePolicy::Error => {
+                return Err(EnvMapError::NonFinite {
+                    path,
+                    count,
+                    first_i: (first % width as usize) as u32,
+                    first_j: (first / width as usize) as u32,
+                });
+            }
+            NonFinitePolicy::Zero => {
+                for &k in &non_finite {
+                    let p = &mut pixels[k];
+                    *p = Vec3::from_array(p.to_array().map(|c| if c.is_finite() { c } else { 0.0 }));
+                }
+                report.non_finite_zeroed = count;
+            }
+        }
+    }
+    let (mut negative, mut positive, mut count) = (0.0f64, 0.0f64, 0usize);
+    for j in 0..height {
+        let sa = crate::latlong::latlong_texel_solid_angle(j, width, height);
+        for p in &pixels[(j * width) as usize..((j + 1) * width) as usize] {
+            for c in p.to_array() {
+                if c < 0.0 {
+                    negative -= f64::from(c) * sa;
+                    count += 1;
+                } else {
+                    positive += f64::from(c) * sa;
+                }
+            }
+        }
+    }
+    if count == 0 {
+        return Ok(());
+    }
+    let fraction = if positive > 0.0 { negative / positive } else { f64::INFINITY };
+    let limit = match options.negative {
+        NegativePolicy::Strict => 0.0,
+        NegativePolicy::Clamp { max_power_fraction } => max_power_fraction,
+    };
+    if options.negative == NegativePolicy::Strict || fraction > limit {
+        return Err(EnvMapError::Negative { path, count, fraction, limit });
+    }
+    pixels.iter_mut().for_each(|p| *p = p.max(Vec3::ZERO));
+    report.negatives_clamped = count;
+    report.negative_power_fraction = fraction;
+    Ok(())
+}

@@ -1,0 +1,116 @@
+//! The lat-long (equirectangular) parameterization: the one direction convention of the toolkit.
+//!
+//! Pixel (i, j) has column i from the left and row j from the top (the file's first scanline).
+//! Texel centre u = (i + 0.5)/W, v = (j + 0.5)/H; phi = 2 pi u, theta = pi v;
+//! direction = (sin theta sin phi, cos theta, -sin theta cos phi). So -Z is the seam u = 0,
+//! +X is u = 0.25, +Z the image centre and +Y the top row: Mitsuba 3's `envmap` orientation.
+
+use glam::{Vec2, Vec3};
+use std::f64::consts::PI as PI64;
+use std::f32::consts::{PI, TAU};
+
+/// Direction for lat-long coordinates `uv` in [0, 1]^2 (any `u` is accepted: it wraps).
+#[inline]
+#[must_use]
+pub fn latlong_uv_to_dir(uv: Vec2) -> Vec3 {
+    let (sin_phi, cos_phi) = (TAU * uv.x).sin_cos();
+    let (sin_theta, cos_theta) = (PI * uv.y).sin_cos();
+    Vec3::new(sin_theta * sin_phi, cos_theta, -sin_theta * cos_phi)
+}
+
+/// Lat-long coordinates of a direction (need not be normalized; must not be zero).
+///
+/// `u` is in [0, 1), `v` in [0, 1]. At the poles (x = z = 0) `u` is 0.5 by the definition of
+/// `atan2(0, -0)`: any `u` describes the pole, this one is returned deterministically.
+/// Theta uses `atan2`, not `acos`, so directions near the poles keep full precision.
+#[inline]
+#[must_use]
+pub fn latlong_dir_to_uv(dir: Vec3) -> Vec2 {
+    let mut u = dir.x.atan2(-dir.z) / TAU;
+    if u < 0.0 {
+        u += 1.0;
+    }
+    // -tiny + 1.0 rounds to 1.0, which is the seam again.
+    if u >= 1.0 {
+        u = 0.0;
+    }
+    let theta = dir.x.hypot(dir.z).atan2(dir.y);
+    Vec2::new(u, (theta / PI).clamp(0.0, 1.0))
+}
+
+/// Solid angle per unit area of (u, v): d omega = 2 pi^2 sin(pi v) du dv.
+#[inline]
+#[must_use]
+pub fn latlong_jacobian(uv: Vec2) -> f32 {
+    2.0 * PI * PI * (PI * uv.y).sin()
+}
+
+/// Exact solid angle of one texel of row `j` in a `width` x `height` map:
+/// (2 pi / W)(cos theta_top - cos theta_bottom). The texels of a map sum to 4 pi.
+#[inline]
+#[must_use]
+pub fn latlong_texel_solid_angle(j: u32, width: u32, height: u32) -> f64 {
+    let (c0, c1) = row_cos_bounds(j, height);
+    2.0 * PI64 / f64::from(width) * (c0 - c1)
+}
+
+/// cos theta at the top and bottom edge of row `j` (top > bottom).
+#[inline]
+#[must_use]
+pub fn row_cos_bounds(j: u32, height: u32) -> (f64, f64) {
+    let h = f64::from(height);
+    ((PI64 * f64::from(j) / h).cos(), (PI64 * f64::from(j + 1) / h).cos())
+}
+
+/// The exact vector solid angle of texel (i, j): the integral of the direction over the texel.
+///
+/// For a texel entirely above the plane with normal `n`, `n . V` is exactly the integral of
+/// cos over it, which makes brute-force irradiance exact away from the horizon.
+#[must_use]
+pub fn latlong_texel_vector(i: u32, j: u32, width: u32, height: u32) -> [f64; 3] {
+    let (w, h) = (f64::from(width), f64::from(height));
+    let (p0, p1) = (2.0 * PI64 * f64::from(i) / w, 2.0 * PI64 * f64::from(i + 1) / w);
+    let (t0, t1) = (PI64 * f64::from(j) / h, PI64 * f64::from(j + 1) / h);
+    // integral of sin^2 theta d theta, and of cos theta sin theta d theta
+    let a = |t: f64| (t - t.sin() * t.cos()) * 0.5;
+    let sin2_theta = a(t1) - a(t0);
+    let cos_sin_theta = 0.5 * (t1.sin().powi(2) - t0.sin().powi(2));
+    [
+        sin2_theta * (p0.cos() - p1.cos()),
+        cos_sin_theta * (p1 - p0),
+        -sin2_theta * (p1.sin() - p0.sin()),
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn named_directions_match_the_convention() {
+        let close = |a: Vec3, b: Vec3| (a - b).length() < 1e-6;
+        assert!(close(latlong_uv_to_dir(Vec2::new(0.0, 0.5)), Vec3::NEG_Z));
+        assert!(close(latlong_uv_to_dir(Vec2::new(0.25, 0.5)), Vec3::X));
+        assert!(close(latlong_uv_to_dir(Vec2::new(0.5, 0.5)), Vec3::Z));
+        assert!(close(latlong_uv_to_dir(Vec2::new(0.75, 0.5)), Vec3::NEG_X));
+        assert!(close(latlong_uv_to_dir(Vec2::new(0.3, 0.0)), Vec3::Y));
+        assert!(close(latlong_uv_to_dir(Vec2::new(0.3, 1.0)), Vec3::NEG_Y));
+    }
+
+    #[test]
+    fn texel_vector_length_is_below_solid_angle_and_points_at_centre() {
+        let (w, h) = (64, 32);
+        for j in [0, 5, 15, 16, 31] {
+            for i in [0, 17, 63] {
+                let v = latlong_texel_vector(i, j, w, h);
+                let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+                let sa = latlong_texel_solid_angle(j, w, h);
+                assert!(len <= sa * (1.0 + 1e-12) && len > 0.99 * sa, "{len} {sa}");
+                let c = latlong_uv_to_dir(Vec2::new((i as f32 + 0.5) / 64.0, (j as f32 + 0.5) / 32.0));
+                let d = Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32).normalize();
+                // a pole texel's centroid sits at 2/3 of its row, not at its centre
+                assert!(c.dot(d) > 0.9995, "{c} {d}");
+            }
+        }
+    }
+}

@@ -1,0 +1,111 @@
+//! Order-2 (9-coefficient) real spherical harmonics: projection of a map and the
+//! Ramamoorthy-Hanrahan irradiance ("An Efficient Representation for Irradiance Environment
+//! Maps", SIGGRAPH 2001).
+//!
+//! The basis is the usual real SH polynomials evaluated on world (x, y, z), in the order
+//! l=0; l=1 m=-1,0,1; l=2 m=-2..2 — the same basis as three.js's `SphericalHarmonics3`.
+
+use crate::envmap::EnvMap;
+use glam::{DVec3, Vec3};
+
+/// 9 RGB coefficients of a function on the sphere.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct Sh9 {
+    /// Coefficients in the order l=0; l=1 m=-1,0,1; l=2 m=-2..2.
+    pub coeffs: [Vec3; 9],
+}
+
+/// Convolution of the clamped cosine with each band, A_l: pi, 2 pi / 3, pi / 4.
+pub const IRRADIANCE_BAND_FACTORS: [f32; 3] =
+    [std::f32::consts::PI, 2.0 * std::f32::consts::PI / 3.0, std::f32::consts::PI / 4.0];
+
+/// The 9 real SH basis functions at unit direction `d`.
+#[must_use]
+pub fn sh9_basis(d: Vec3) -> [f32; 9] {
+    let (x, y, z) = (d.x, d.y, d.z);
+    [
+        0.282_094_8,
+        0.488_602_5 * y,
+        0.488_602_5 * z,
+        0.488_602_5 * x,
+        1.092_548_4 * x * y,
+        1.092_548_4 * y * z,
+        0.315_391_57 * (3.0 * z * z - 1.0),
+        1.092_548_4 * x * z,
+        0.546_274_2 * (x * x - y * y),
+    ]
+}
+
+/// Band l of coefficient index k.
+const BAND: [usize; 9] = [0, 1, 1, 1, 2, 2, 2, 2, 2];
+
+impl Sh9 {
+    /// Projects a map onto the basis: c_k = sum over texels of L Y_k(w_centre) d omega.
+    #[must_use]
+    pub fn project(map: &EnvMap) -> Self {
+        let mut acc = [DVec3::ZERO; 9];
+        for j in 0..map.height() {
+            let sa = map.texel_solid_angle(j);
+            for (i, l) in map.row(j).iter().enumerate() {
+                let basis = sh9_basis(map.texel_dir(i as u32, j));
+                let l = l.as_dvec3() * sa;
+                for (a, b) in acc.iter_mut().zip(basis) {
+                    *a += l * f64::from(b);
+                }
+            }
+        }
+        Self { coeffs: acc.map(|c| c.as_vec3()) }
+    }
+
+    /// The function value sum c_k Y_k(d).
+    #[must_use]
+    pub fn eval(&self, d: Vec3) -> Vec3 {
+        sh9_basis(d).iter().zip(&self.coeffs).map(|(b, c)| *c * *b).sum()
+    }
+
+    /// Irradiance for unit normal `n`: sum A_l c_k Y_k(n) (Ramamoorthy and Hanrahan).
+    #[must_use]
+    pub fn irradiance(&self, n: Vec3) -> Vec3 {
+        sh9_basis(n)
+            .iter()
+            .zip(&self.coeffs)
+            .enumerate()
+            .map(|(k, (b, c))| *c * (*b * IRRADIANCE_BAND_FACTORS[BAND[k]]))
+            .sum()
+    }
+
+    /// A map whose texels hold this function at their centres (a band-limited test map).
+    #[must_use]
+    pub fn to_map(&self, width: u32, height: u32) -> EnvMap {
+        EnvMap::from_fn(width, height, |d| self.eval(d))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn basis_is_orthonormal_under_the_texel_quadrature() {
+        let (w, h) = (256, 128);
+        let map = EnvMap::constant(w, h, Vec3::ONE);
+        let mut gram = [[0.0f64; 9]; 9];
+        for j in 0..h {
+            let sa = map.texel_solid_angle(j);
+            for i in 0..w {
+                let b = sh9_basis(map.texel_dir(i, j));
+                for a in 0..9 {
+                    for c in 0..9 {
+                        gram[a][c] += f64::from(b[a]) * f64::from(b[c]) * sa;
+                    }
+                }
+            }
+        }
+        for (a, row) in gram.iter().enumerate() {
+            for (c, g) in row.iter().enumerate() {
+                let want = if a == c { 1.0 } else { 0.0 };
+                assert!((g - want).abs() < 2e-4, "<Y{a}, Y{c}> = {g}");
+            }
+        }
+    }
+}

@@ -1,0 +1,52 @@
+//! Repository rules that can be tests (rust-analyzer's tidy): each failure names the file.
+
+use workspace_tests::{rust_sources, workspace_root};
+
+#[test]
+fn sources_are_found() {
+    let sources = rust_sources();
+    assert!(sources.len() > 10, "found only {} .rs files under {}", sources.len(), workspace_root().display());
+}
+
+#[test]
+fn every_module_starts_with_a_doc_comment() {
+    let missing: Vec<String> = rust_sources()
+        .into_iter()
+        .filter(|p| {
+            let text = std::fs::read_to_string(p).unwrap_or_default();
+            !text.trim_start().starts_with("//!")
+        })
+        .map(|p| p.display().to_string())
+        .collect();
+    assert!(missing.is_empty(), "modules without a `//!` summary:\n{}", missing.join("\n"));
+}
+
+#[test]
+fn no_ignored_tests_and_no_stubs() {
+    // Built from parts so this file does not trip its own check.
+    let banned = [concat!("#[", "ignore"), concat!("todo", "!("), concat!("unimplemented", "!(")];
+    let mut hits = Vec::new();
+    for p in rust_sources() {
+        let text = std::fs::read_to_string(&p).unwrap_or_default();
+        for (n, line) in text.lines().enumerate() {
+            for b in banned {
+                if line.contains(b) {
+                    hits.push(format!("{}:{}: {}", p.display(), n + 1, line.trim()));
+                }
+            }
+        }
+    }
+    assert!(hits.is_empty(), "ignored tests or stubs:\n{}", hits.join("\n"));
+}
+
+#[test]
+fn every_crate_shares_the_workspace_lints() {
+    let root = workspace_root();
+    let mut manifests = Vec::new();
+    workspace_tests::collect(&root.join("crates"), "toml", &mut manifests);
+    manifests.extend([root.join("xtask/Cargo.toml"), root.join("tests/Cargo.toml"), root.join("benches/Cargo.toml")]);
+    for m in manifests.iter().filter(|m| m.ends_with("Cargo.toml")) {
+        let text = std::fs::read_to_string(m).unwrap_or_default();
+        assert!(text.contains("[lints]\nworkspace = true"), "{} does not use [workspace.lints]", m.display());
+    }
+}
