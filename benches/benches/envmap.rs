@@ -17,9 +17,7 @@ fn integrals(c: &mut Criterion) {
     c.bench_function("sh9_project_1024x512", |b| b.iter(|| Sh9::project(black_box(&map))));
     c.bench_function("power_1024x512", |b| b.iter(|| black_box(&map).power()));
     c.bench_function("irradiance_brute_force_1024x512", |b| b.iter(|| black_box(&map).irradiance(Vec3::Y)));
-    c.bench_function("resample_to_cube_128", |b| {
-        b.iter(|| black_box(&map).to_layout(Layout::CubeStrip { face: 128 }))
-    });
+    c.bench_function("resample_to_cube_128", |b| b.iter(|| black_box(&map).to_layout(Layout::CubeStrip { face: 128 })));
 }
 
 fn sampling(c: &mut Criterion) {

@@ -39,7 +39,10 @@ impl MapInfo {
         println!("{name}");
         println!("  size          {} x {}", self.width, self.height);
         println!("  format        {} ({})", self.format, self.compression);
-        println!("  luminance     max {:.6}, mean {:.6} per pixel, {:.6} per sr", self.max_luminance, self.mean_luminance, stats.mean_per_sr);
+        println!(
+            "  luminance     max {:.6}, mean {:.6} per pixel, {:.6} per sr",
+            self.max_luminance, self.mean_luminance, stats.mean_per_sr
+        );
         println!(
             "  percentiles   50%: {:.4}  90%: {:.4}  98%: {:.4}  99.9%: {:.4}",
             stats.percentile(50.0),
@@ -47,7 +50,10 @@ impl MapInfo {
             stats.percentile(98.0),
             stats.percentile(99.9)
         );
-        println!("  power         [{:.6}, {:.6}, {:.6}] (integral of radiance over the sphere)", self.power[0], self.power[1], self.power[2]);
+        println!(
+            "  power         [{:.6}, {:.6}, {:.6}] (integral of radiance over the sphere)",
+            self.power[0], self.power[1], self.power[2]
+        );
         let labels = ["l0", "l1 m-1", "l1 m0", "l1 m1", "l2 m-2", "l2 m-1", "l2 m0", "l2 m1", "l2 m2"];
         for (label, c) in labels.iter().zip(&self.sh9) {
             println!("  sh9 {label:<7}  [{:+.6}, {:+.6}, {:+.6}]", c[0], c[1], c[2]);

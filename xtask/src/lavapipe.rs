@@ -12,9 +12,8 @@ const INSTALL: &str = "apt-get update && apt-get install -y --no-install-recomme
 /// Whether a lavapipe ICD manifest (`lvp_icd*.json`) is present.
 pub fn installed() -> bool {
     ICD_DIRS.iter().any(|dir| {
-        std::fs::read_dir(Path::new(dir)).is_ok_and(|entries| {
-            entries.flatten().any(|e| e.file_name().to_string_lossy().starts_with("lvp_icd"))
-        })
+        std::fs::read_dir(Path::new(dir))
+            .is_ok_and(|entries| entries.flatten().any(|e| e.file_name().to_string_lossy().starts_with("lvp_icd")))
     })
 }
 

@@ -11,10 +11,9 @@ pub fn run(envmap: Option<&Path>) -> Result<(), String> {
     let start = Instant::now();
     println!("[1/1] load environment map");
     let (name, (map, report)) = match envmap {
-        Some(path) => (
-            path.display().to_string(),
-            EnvMap::load_with(path, &LoadOptions::default()).map_err(|e| e.to_string())?,
-        ),
+        Some(path) => {
+            (path.display().to_string(), EnvMap::load_with(path, &LoadOptions::default()).map_err(|e| e.to_string())?)
+        }
         None => (
             format!("{DEFAULT_MAP_NAME} (embedded default; {DEFAULT_MAP_CREDIT})"),
             EnvMap::load_from_bytes(envmap_sphere::default_map_bytes(), DEFAULT_MAP_NAME, &LoadOptions::default())

@@ -31,8 +31,7 @@ impl Distribution1D {
     /// When `weights` is empty.
     #[must_use]
     pub fn new(weights: impl IntoIterator<Item = f64>) -> Self {
-        let mut func: Vec<f64> =
-            weights.into_iter().map(|w| if w.is_finite() && w > 0.0 { w } else { 0.0 }).collect();
+        let mut func: Vec<f64> = weights.into_iter().map(|w| if w.is_finite() && w > 0.0 { w } else { 0.0 }).collect();
         assert!(!func.is_empty(), "a distribution needs at least one cell");
         let n = func.len() as f64;
         let mut cdf = Vec::with_capacity(func.len() + 1);
@@ -139,8 +138,7 @@ impl EnvDistribution {
         let total: f64 = (0..h).map(|j| (0..w).map(|i| lum(i, j)).sum::<f64>() * sa[j as usize]).sum();
         let black = !(total.is_finite() && total > 0.0);
         let weight = |i: u32, j: u32| if black { sa[j as usize] } else { lum(i, j) * sa[j as usize] };
-        let cols: Vec<Distribution1D> =
-            (0..h).map(|j| Distribution1D::new((0..w).map(|i| weight(i, j)))).collect();
+        let cols: Vec<Distribution1D> = (0..h).map(|j| Distribution1D::new((0..w).map(|i| weight(i, j)))).collect();
         let rows = Distribution1D::new(cols.iter().map(Distribution1D::integral));
         let norm = if black { 4.0 * std::f64::consts::PI } else { total };
         let texel_pdf = (0..h)
@@ -168,7 +166,9 @@ impl EnvDistribution {
         let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
         let (sp, cp) = phi.sin_cos();
         let dir = Vec3::new(sin_theta * sp, cos_theta, -sin_theta * cp);
-        DirSample { dir, pdf: self.texel_pdf[j * self.width as usize + i] }
+        // The pdf of the texel the f32 direction lies in: a sample drawn within rounding of a
+        // texel edge may land in the neighbour, and MIS needs sample_dir and dir_pdf to agree.
+        DirSample { dir, pdf: self.dir_pdf(dir) }
     }
 
     /// Density with respect to solid angle of sampling `dir` (need not be normalized).

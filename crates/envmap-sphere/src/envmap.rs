@@ -173,9 +173,7 @@ impl EnvMap {
     #[must_use]
     pub fn rotate_columns(&self, columns: i64) -> Self {
         let w = i64::from(self.width);
-        Self::from_texels(self.width, self.height, |i, j| {
-            self.pixel((i64::from(i) - columns).rem_euclid(w) as u32, j)
-        })
+        Self::from_texels(self.width, self.height, |i, j| self.pixel((i64::from(i) - columns).rem_euclid(w) as u32, j))
     }
 }
 

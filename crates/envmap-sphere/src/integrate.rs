@@ -78,13 +78,7 @@ impl EnvMap {
             .sum();
         let mut sorted = lum;
         sorted.sort_unstable_by(f32::total_cmp);
-        LuminanceStats {
-            max,
-            min,
-            mean_per_pixel,
-            mean_per_sr: per_sr / (4.0 * std::f64::consts::PI),
-            sorted,
-        }
+        LuminanceStats { max, min, mean_per_pixel, mean_per_sr: per_sr / (4.0 * std::f64::consts::PI), sorted }
     }
 }
 

@@ -205,17 +205,24 @@ pub fn save_exr_rgb(path: &Path, width: usize, height: usize, pixels: &[Vec3]) -
         (c.x, c.y, c.z)
     });
     let layer = Layer::new((width, height), LayerAttributes::named("rgb"), Encoding::SMALL_LOSSLESS, channels);
-    Image::from_layer(layer)
-        .write()
-        .to_file(path)
-        .map_err(|e| EnvMapError::Encode { path: path.to_path_buf(), format: "OpenEXR", reason: e.to_string() })
+    Image::from_layer(layer).write().to_file(path).map_err(|e| EnvMapError::Encode {
+        path: path.to_path_buf(),
+        format: "OpenEXR",
+        reason: e.to_string(),
+    })
 }
 
 /// Writes row-major linear RGB as an 8-bit sRGB PNG through `tonemap`.
 ///
 /// # Errors
 /// [`EnvMapError::Encode`] when the file cannot be written.
-pub fn save_png_rgb(path: &Path, width: u32, height: u32, pixels: &[Vec3], tonemap: &Tonemap) -> Result<(), EnvMapError> {
+pub fn save_png_rgb(
+    path: &Path,
+    width: u32,
+    height: u32,
+    pixels: &[Vec3],
+    tonemap: &Tonemap,
+) -> Result<(), EnvMapError> {
     let bytes: Vec<u8> = pixels.iter().flat_map(|p| tonemap.apply(*p)).collect();
     image::save_buffer_with_format(path, &bytes, width, height, image::ExtendedColorType::Rgb8, image::ImageFormat::Png)
         .map_err(|e| EnvMapError::Encode { path: path.to_path_buf(), format: "PNG", reason: e.to_string() })
@@ -300,8 +307,7 @@ fn sanitize(
     report: &mut LoadReport,
 ) -> Result<(), EnvMapError> {
     let path: PathBuf = path.to_path_buf();
-    let non_finite: Vec<usize> =
-        pixels.iter().enumerate().filter(|(_, p)| !p.is_finite()).map(|(k, _)| k).collect();
+    let non_finite: Vec<usize> = pixels.iter().enumerate().filter(|(_, p)| !p.is_finite()).map(|(k, _)| k).collect();
     if let Some(&first) = non_finite.first() {
         let count: usize = non_finite.iter().map(|&k| (0..3).filter(|&c| !pixels[k][c].is_finite()).count()).sum();
         match options.non_finite {

@@ -6,8 +6,8 @@
 //! +X is u = 0.25, +Z the image centre and +Y the top row: Mitsuba 3's `envmap` orientation.
 
 use glam::{Vec2, Vec3};
-use std::f64::consts::PI as PI64;
 use std::f32::consts::{PI, TAU};
+use std::f64::consts::PI as PI64;
 
 /// Direction for lat-long coordinates `uv` in [0, 1]^2 (any `u` is accepted: it wraps).
 #[inline]
@@ -75,11 +75,7 @@ pub fn latlong_texel_vector(i: u32, j: u32, width: u32, height: u32) -> [f64; 3]
     let a = |t: f64| (t - t.sin() * t.cos()) * 0.5;
     let sin2_theta = a(t1) - a(t0);
     let cos_sin_theta = 0.5 * (t1.sin().powi(2) - t0.sin().powi(2));
-    [
-        sin2_theta * (p0.cos() - p1.cos()),
-        cos_sin_theta * (p1 - p0),
-        -sin2_theta * (p1.sin() - p0.sin()),
-    ]
+    [sin2_theta * (p0.cos() - p1.cos()), cos_sin_theta * (p1 - p0), -sin2_theta * (p1.sin() - p0.sin())]
 }
 
 #[cfg(test)]

@@ -85,9 +85,7 @@ impl SummedAreaTable<1> {
     #[must_use]
     pub fn luminance_power(map: &EnvMap) -> Self {
         let sa = map.row_solid_angles();
-        Self::from_fn(map.width(), map.height(), |i, j| {
-            [f64::from(luminance(map.pixel(i, j))) * sa[j as usize]]
-        })
+        Self::from_fn(map.width(), map.height(), |i, j| [f64::from(luminance(map.pixel(i, j))) * sa[j as usize]])
     }
 }
 
@@ -96,8 +94,6 @@ impl SummedAreaTable<3> {
     #[must_use]
     pub fn rgb_power(map: &EnvMap) -> Self {
         let sa = map.row_solid_angles();
-        Self::from_fn(map.width(), map.height(), |i, j| {
-            (map.pixel(i, j).as_dvec3() * sa[j as usize]).to_array()
-        })
+        Self::from_fn(map.width(), map.height(), |i, j| (map.pixel(i, j).as_dvec3() * sa[j as usize]).to_array())
     }
 }

@@ -1,0 +1,114 @@
+//! The lat-long convention: orientation, solid angles, round trips, seam and poles.
+
+mod common;
+
+use envmap_sphere::latlong::{latlong_dir_to_uv, latlong_texel_solid_angle, latlong_uv_to_dir};
+use envmap_sphere::{EnvMap, Sh9};
+use glam::{Vec2, Vec3};
+use std::f64::consts::PI;
+
+fn formula_dir(i: u32, j: u32, w: u32, h: u32) -> Vec3 {
+    // Written out from the convention, independently of the library.
+    let u = (f64::from(i) + 0.5) / f64::from(w);
+    let v = (f64::from(j) + 0.5) / f64::from(h);
+    let (phi, theta) = (2.0 * PI * u, PI * v);
+    Vec3::new((theta.sin() * phi.sin()) as f32, theta.cos() as f32, (-theta.sin() * phi.cos()) as f32)
+}
+
+#[test]
+fn solid_angles_sum_to_four_pi() {
+    for (w, h) in [(1024, 512), (8, 4), (7, 3), (4096, 2048), (1, 1)] {
+        let sum: f64 = (0..h).map(|j| latlong_texel_solid_angle(j, w, h) * f64::from(w)).sum();
+        assert!((sum / (4.0 * PI) - 1.0).abs() < 1e-6, "{w}x{h}: {sum}");
+    }
+}
+
+#[test]
+fn one_bright_texel_lies_in_the_formula_direction() {
+    let (w, h) = (64, 32);
+    for (i, j) in [(0, 0), (16, 16), (32, 16), (48, 7), (63, 31), (5, 25)] {
+        let mut map = EnvMap::constant(w, h, Vec3::ZERO);
+        map.set_pixel(i, j, Vec3::ONE);
+        let want = formula_dir(i, j, w, h);
+        assert!((map.texel_dir(i, j) - want).length() < 1e-6, "texel ({i}, {j})");
+        assert_eq!(map.texel_of_dir(want), (i, j));
+        assert_eq!(map.lookup_nearest(want), Vec3::ONE);
+        // Independent of the lookup code: the l = 1 SH coefficients are proportional to the
+        // mean direction of the light, (c[3], c[1], c[2]) ~ (x, y, z).
+        let sh = Sh9::project(&map);
+        let d = Vec3::new(sh.coeffs[3].x, sh.coeffs[1].x, sh.coeffs[2].x).normalize();
+        assert!(d.dot(want) > 0.9999, "({i}, {j}): SH says {d}, formula {want}");
+    }
+}
+
+#[test]
+fn named_directions_sit_where_the_convention_says() {
+    let (w, h) = (1024, 512);
+    let map = EnvMap::constant(w, h, Vec3::ZERO);
+    // -Z at the seam u = 0, +X at u = 0.25, +Z at the centre, -X at u = 0.75, +Y the top row.
+    assert_eq!(map.texel_of_dir(Vec3::new(-1e-4, 0.0, -1.0)), (1023, 256));
+    assert_eq!(map.texel_of_dir(Vec3::new(1e-4, 0.0, -1.0)), (0, 256));
+    assert_eq!(map.texel_of_dir(Vec3::new(1.0, 1e-4, 0.0)), (256, 255));
+    assert_eq!(map.texel_of_dir(Vec3::new(-1e-4, -1e-4, 1.0)), (512, 256));
+    assert_eq!(map.texel_of_dir(Vec3::new(-1.0, 1e-4, 1e-4)), (767, 255));
+    assert_eq!(map.texel_of_dir(Vec3::Y).1, 0);
+    assert_eq!(map.texel_of_dir(Vec3::NEG_Y).1, 511);
+}
+
+#[test]
+fn dir_uv_dir_round_trips_for_random_directions() {
+    let mut rng = common::rng(7);
+    for _ in 0..100_000 {
+        let d = common::random_dir(&mut rng);
+        let uv = latlong_dir_to_uv(d);
+        assert!((0.0..1.0).contains(&uv.x) && (0.0..=1.0).contains(&uv.y), "{d} -> {uv}");
+        let back = latlong_uv_to_dir(uv);
+        assert!((back - d).length() < 2e-6, "{d} -> {uv} -> {back}");
+    }
+}
+
+#[test]
+fn round_trips_hold_at_the_poles_and_the_seam() {
+    for d in [Vec3::Y, Vec3::NEG_Y, Vec3::new(1e-7, 1.0, 0.0).normalize(), Vec3::new(0.0, -1.0, 1e-7).normalize()] {
+        let uv = latlong_dir_to_uv(d);
+        assert!(uv.is_finite());
+        assert!((latlong_uv_to_dir(uv) - d).length() < 1e-6, "{d} -> {uv}");
+    }
+    assert_eq!(latlong_dir_to_uv(Vec3::Y).y, 0.0);
+    assert_eq!(latlong_dir_to_uv(Vec3::NEG_Y).y, 1.0);
+    // Either side of the seam, and exactly on it.
+    for x in [-1e-6f32, -f32::MIN_POSITIVE, 0.0, -0.0, f32::MIN_POSITIVE, 1e-6] {
+        let d = Vec3::new(x, 0.3, -1.0).normalize();
+        let uv = latlong_dir_to_uv(d);
+        assert!((0.0..1.0).contains(&uv.x), "x = {x}: u = {}", uv.x);
+        assert!((latlong_uv_to_dir(uv) - d).length() < 1e-6);
+    }
+    // u = 1 - eps and u = 1 are the seam again.
+    let a = latlong_uv_to_dir(Vec2::new(1.0 - f32::EPSILON, 0.5));
+    let b = latlong_uv_to_dir(Vec2::new(1.0, 0.5));
+    assert!((a - Vec3::NEG_Z).length() < 1e-5 && (b - Vec3::NEG_Z).length() < 1e-5);
+}
+
+#[test]
+fn bilinear_lookup_wraps_in_u_and_clamps_in_v() {
+    let (w, h) = (16, 8);
+    let map = EnvMap::from_texels(w, h, |i, j| match (i, j) {
+        (0, _) => Vec3::new(2.0, 0.0, 0.0),
+        (15, _) => Vec3::new(0.0, 4.0, 0.0),
+        _ => Vec3::ZERO,
+    });
+    // u = 0 lies halfway between the centres of columns 15 and 0.
+    let seam = map.lookup_uv(Vec2::new(0.0, 0.5));
+    assert!((seam - Vec3::new(1.0, 2.0, 0.0)).length() < 1e-5, "{seam}");
+    let top = map.lookup_uv(Vec2::new(0.5 / 16.0, 0.0));
+    assert!((top - Vec3::new(2.0, 0.0, 0.0)).length() < 1e-5, "{top}");
+}
+
+#[test]
+fn rotating_by_columns_rotates_directions_about_y() {
+    let map = EnvMap::from_texels(32, 16, |i, j| Vec3::new(i as f32, j as f32, 1.0));
+    let rotated = map.rotate_columns(8); // +90 degrees of phi
+    // phi grows: the direction of old texel (i, j) is now found at column i + 8.
+    assert_eq!(rotated.pixel(10, 3), map.pixel(2, 3));
+    assert_eq!(rotated.pixel(2, 3), map.pixel(26, 3));
+}

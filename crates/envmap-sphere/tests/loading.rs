@@ -1,0 +1,218 @@
+//! Loading real maps, and every class of bad input returning its typed error naming the file.
+
+mod common;
+
+use envmap_sphere::{EnvMap, EnvMapError, FileFormat, LoadOptions, NegativePolicy, NonFinitePolicy, luminance};
+use glam::Vec3;
+use std::path::Path;
+
+#[test]
+fn every_shared_map_loads() {
+    // (file, max luminance, mean luminance) from ../shared/envmaps/README.md
+    let readme = [
+        ("adams_place_bridge_1k.hdr", 110.7, 1.30),
+        ("empty_warehouse_01_1k.hdr", 400.3, 0.65),
+        ("forest_slope_1k.hdr", 59.4, 0.70),
+        ("kiara_1_dawn_1k.hdr", 46.2, 0.70),
+        ("lebombo_1k.hdr", 23.3, 0.65),
+        ("potsdamer_platz_1k.hdr", 10.9, 0.68),
+        ("st_fagans_interior_1k.hdr", 1110.9, 0.73),
+        ("venice_sunset_1k.hdr", 2090.5, 0.43),
+        ("studio.exr", 110.9, 0.25),
+        ("courtyard.exr", 52.9, 0.54),
+        ("city.exr", 31749.0, 1.05),
+    ];
+    let maps = common::shared_maps();
+    for (name, max, mean) in readme {
+        let path = maps.iter().find(|p| p.ends_with(name)).unwrap_or_else(|| panic!("{name} missing"));
+        let (map, report) = EnvMap::load_with(path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!((map.width(), map.height()), (1024, 512), "{name}");
+        let stats = map.luminance_stats();
+        // the README rounds to one decimal (city.exr to the unit)
+        assert!((f64::from(stats.max) - max).abs() <= 0.05 + 1e-4 * max, "{name}: max {}", stats.max);
+        assert!((stats.mean_per_pixel - mean).abs() < 0.006, "{name}: mean {}", stats.mean_per_pixel);
+        assert!(map.pixels().iter().all(|p| p.is_finite() && p.min_element() >= 0.0));
+        if name.ends_with(".exr") {
+            assert_eq!((report.format, report.compression.as_str()), (FileFormat::Exr, "dwab"), "{name}");
+        } else {
+            assert_eq!(report.format, FileFormat::Hdr);
+        }
+    }
+}
+
+#[test]
+fn dwab_negative_ringing_is_clamped_and_reported() {
+    // Counts are channel values below zero, as the shared README gives them.
+    for (name, count) in [("city.exr", 506), ("courtyard.exr", 1818), ("studio.exr", 3)] {
+        let path = common::envmaps_dir().join(name);
+        let (map, report) = EnvMap::load_with(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(report.negatives_clamped, count, "{name}");
+        assert!(
+            report.negative_power_fraction > 0.0 && report.negative_power_fraction < 1e-6,
+            "{name}: {}",
+            report.negative_power_fraction
+        );
+        assert!(map.pixels().iter().all(|p| p.min_element() >= 0.0));
+        let strict = LoadOptions { negative: NegativePolicy::Strict, ..LoadOptions::default() };
+        let err = EnvMap::load_with(&path, &strict).expect_err("strict mode refuses negatives");
+        assert!(matches!(err, EnvMapError::Negative { count: c, .. } if c == count), "{err}");
+    }
+}
+
+fn expect_error(path: &Path, options: &LoadOptions) -> EnvMapError {
+    let err = EnvMap::load_with(path, options).expect_err("bad input must be refused");
+    let message = err.to_string();
+    assert!(message.contains(&path.display().to_string()), "message does not name the file: {message}");
+    assert!(!message.contains('\n'), "one line: {message}");
+    err
+}
+
+#[test]
+fn missing_empty_and_non_image_files_are_refused() {
+    let dir = common::scratch_dir("bad-input-basic");
+    let err = expect_error(&dir.join("nope.exr"), &LoadOptions::default());
+    assert!(matches!(err, EnvMapError::Io { .. }), "{err}");
+    std::fs::write(dir.join("empty.hdr"), b"").unwrap();
+    assert!(matches!(expect_error(&dir.join("empty.hdr"), &LoadOptions::default()), EnvMapError::Empty { .. }));
+    std::fs::write(dir.join("notes.exr"), b"this is text, not an image\n").unwrap();
+    assert!(matches!(expect_error(&dir.join("notes.exr"), &LoadOptions::default()), EnvMapError::UnknownFormat { .. }));
+    let err = expect_error(&dir, &LoadOptions::default());
+    assert!(matches!(err, EnvMapError::Io { .. }), "a directory: {err}");
+}
+
+#[test]
+fn truncated_files_are_refused() {
+    let dir = common::scratch_dir("bad-input-truncated");
+    for name in ["city.exr", "venice_sunset_1k.hdr"] {
+        let bytes = std::fs::read(common::envmaps_dir().join(name)).unwrap();
+        for cut in [8, 200, bytes.len() / 2, bytes.len() - 10] {
+            let path = dir.join(format!("cut{cut}-{name}"));
+            std::fs::write(&path, &bytes[..cut]).unwrap();
+            let err = expect_error(&path, &LoadOptions::default());
+            assert!(matches!(err, EnvMapError::Decode { .. }), "{name} cut at {cut}: {err}");
+        }
+    }
+}
+
+#[test]
+fn huge_claimed_sizes_are_refused_before_allocating() {
+    let dir = common::scratch_dir("bad-input-huge");
+    // Radiance: the header claims 2,000,000 x 1,000,000 over a few bytes of data.
+    let hdr = dir.join("huge.hdr");
+    std::fs::write(&hdr, b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1000000 +X 2000000\n\x02\x02\x00\x00").unwrap();
+    let err = expect_error(&hdr, &LoadOptions::default());
+    assert!(matches!(err, EnvMapError::TooLarge { width: 2_000_000, height: 1_000_000, .. }), "{err}");
+    // OpenEXR: a valid small file whose data window is patched to 200000 x 100000.
+    let exr = dir.join("huge.exr");
+    EnvMap::constant(8, 4, Vec3::ONE).save_exr(&exr).unwrap();
+    let mut bytes = std::fs::read(&exr).unwrap();
+    let key = b"dataWindow\0box2i\0";
+    let at = bytes.windows(key.len()).position(|w| w == key).expect("dataWindow attribute") + key.len() + 4;
+    bytes[at + 8..at + 12].copy_from_slice(&199_999i32.to_le_bytes());
+    bytes[at + 12..at + 16].copy_from_slice(&99_999i32.to_le_bytes());
+    std::fs::write(&exr, &bytes).unwrap();
+    let err = expect_error(&exr, &LoadOptions::default());
+    assert!(matches!(err, EnvMapError::TooLarge { width: 200_000, height: 100_000, .. }), "{err}");
+    // A smaller limit applies too.
+    let small = LoadOptions { max_pixels: 1000, ..LoadOptions::default() };
+    let city = common::envmaps_dir().join("city.exr");
+    assert!(matches!(expect_error(&city, &small), EnvMapError::TooLarge { limit: 1000, .. }));
+}
+
+#[test]
+fn zero_sized_images_are_refused() {
+    let dir = common::scratch_dir("bad-input-zero");
+    let hdr = dir.join("zero.hdr");
+    std::fs::write(&hdr, b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 0 +X 0\n").unwrap();
+    let err = expect_error(&hdr, &LoadOptions::default());
+    assert!(matches!(err, EnvMapError::InvalidSize { .. } | EnvMapError::Decode { .. }), "{err}");
+    assert!(EnvMap::try_new(0, 4, vec![]).is_err());
+    assert!(EnvMap::try_new(2, 1, vec![Vec3::ZERO]).is_err());
+}
+
+#[test]
+fn non_finite_pixels_are_an_error_or_zeroed_on_request() {
+    let dir = common::scratch_dir("bad-input-nan");
+    let path = dir.join("nan.exr");
+    let mut map = EnvMap::constant(16, 8, Vec3::ONE);
+    map.set_pixel(3, 2, Vec3::new(f32::NAN, 1.0, 1.0));
+    map.set_pixel(5, 6, Vec3::new(1.0, f32::INFINITY, f32::NEG_INFINITY));
+    map.save_exr(&path).unwrap();
+    let err = expect_error(&path, &LoadOptions::default());
+    assert!(matches!(err, EnvMapError::NonFinite { count: 3, first_i: 3, first_j: 2, .. }), "{err}");
+    let zero = LoadOptions { non_finite: NonFinitePolicy::Zero, ..LoadOptions::default() };
+    let (loaded, report) = EnvMap::load_with(&path, &zero).unwrap();
+    assert_eq!(report.non_finite_zeroed, 3);
+    assert_eq!(loaded.pixel(3, 2), Vec3::new(0.0, 1.0, 1.0));
+    assert_eq!(loaded.pixel(5, 6), Vec3::new(1.0, 0.0, 0.0));
+}
+
+#[test]
+fn large_negative_power_is_a_broken_file() {
+    let dir = common::scratch_dir("bad-input-negative");
+    let path = dir.join("negative.exr");
+    let mut map = EnvMap::constant(16, 8, Vec3::ONE);
+    map.set_pixel(4, 4, Vec3::splat(-5.0));
+    map.save_exr(&path).unwrap();
+    let err = expect_error(&path, &LoadOptions::default());
+    assert!(matches!(err, EnvMapError::Negative { count: 3, .. }), "{err}");
+    // A looser limit accepts and clamps it.
+    let loose = LoadOptions { negative: NegativePolicy::Clamp { max_power_fraction: 0.5 }, ..LoadOptions::default() };
+    let (loaded, report) = EnvMap::load_with(&path, &loose).unwrap();
+    assert_eq!((report.negatives_clamped, loaded.pixel(4, 4)), (3, Vec3::ZERO));
+}
+
+#[test]
+fn aspect_ratios_other_than_two_to_one() {
+    let dir = common::scratch_dir("bad-input-aspect");
+    for (w, h, ok) in [(64, 16, true), (64, 64, true), (48, 32, true), (16, 64, false), (80, 16, false)] {
+        let path = dir.join(format!("{w}x{h}.exr"));
+        EnvMap::try_new(w, h, vec![Vec3::ONE; (w * h) as usize]).unwrap().save_exr(&path).unwrap();
+        if ok {
+            let (_, report) = EnvMap::load_with(&path, &LoadOptions::default()).unwrap();
+            assert_eq!(report.warnings.len(), 1, "{w}x{h}: {:?}", report.warnings);
+        } else {
+            assert!(matches!(expect_error(&path, &LoadOptions::default()), EnvMapError::NotLatLong { .. }));
+        }
+    }
+}
+
+#[test]
+fn exr_without_rgb_channels_is_refused() {
+    use exr::prelude::*;
+    let dir = common::scratch_dir("bad-input-channels");
+    let path = dir.join("gray.exr");
+    let channel = AnyChannel::new("Y", FlatSamples::F32(vec![0.5; 32]));
+    let layer = Layer::new(
+        (8, 4),
+        LayerAttributes::named("gray"),
+        Encoding::UNCOMPRESSED,
+        AnyChannels::sort(SmallVec::from_vec(vec![channel])),
+    );
+    Image::from_layer(layer).write().to_file(&path).unwrap();
+    let err = expect_error(&path, &LoadOptions::default());
+    assert!(err.to_string().contains("no R, G, B channels"), "{err}");
+}
+
+#[test]
+fn saved_exr_round_trips_exactly_and_previews_are_written() {
+    let dir = common::scratch_dir("round-trip");
+    let map = envmap_sphere::default_map().resize(256, 128);
+    map.save_exr(dir.join("a.exr")).unwrap();
+    let (back, report) = EnvMap::load_with(dir.join("a.exr"), &LoadOptions::default()).unwrap();
+    assert_eq!(back, map);
+    assert_eq!(report.compression, "zip16");
+    map.save_png_preview(dir.join("a.png")).unwrap();
+    let png = std::fs::read(dir.join("a.png")).unwrap();
+    assert!(png.starts_with(b"\x89PNG"));
+    let err = map.save_exr(dir.join("no/such/dir/a.exr")).expect_err("unwritable");
+    assert!(err.to_string().contains("no/such/dir"), "{err}");
+}
+
+#[test]
+fn embedded_default_map_is_the_shared_city_map() {
+    let map = envmap_sphere::default_map();
+    let shared = EnvMap::load(common::envmaps_dir().join("city.exr")).unwrap();
+    assert_eq!(map, shared);
+    assert!(luminance(map.pixels().iter().copied().fold(Vec3::ZERO, Vec3::max)) > 10_000.0);
+}
