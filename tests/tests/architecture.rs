@@ -1,0 +1,88 @@
+//! Each crate's architecture invariant (docs/architecture.md), checked on the real dependency
+//! graph from `cargo metadata`, transitive dependencies included.
+
+use std::collections::{BTreeSet, HashMap};
+use std::process::Command;
+
+/// package name -> names of its normal (non-dev) dependencies, resolved.
+fn dependency_graph() -> HashMap<String, Vec<String>> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    // Only the host's packages: other platforms' crates are not downloaded.
+    let rustc = Command::new("rustc").arg("-vV").output().expect("run rustc -vV");
+    let host = String::from_utf8_lossy(&rustc.stdout)
+        .lines()
+        .find_map(|l| l.strip_prefix("host: ").map(str::to_string))
+        .expect("rustc -vV names the host");
+    let out = Command::new(cargo)
+        .args(["metadata", "--format-version", "1", "--filter-platform", &host])
+        .current_dir(workspace_tests::workspace_root())
+        .output()
+        .expect("run cargo metadata");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let meta: serde_json::Value = serde_json::from_slice(&out.stdout).expect("metadata JSON");
+    let names: HashMap<&str, &str> = meta["packages"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(|p| Some((p["id"].as_str()?, p["name"].as_str()?)))
+        .collect();
+    let mut graph = HashMap::new();
+    for node in meta["resolve"]["nodes"].as_array().into_iter().flatten() {
+        let Some(name) = node["id"].as_str().and_then(|id| names.get(id)) else { continue };
+        let deps = node["deps"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .filter(|d| {
+                d["dep_kinds"].as_array().into_iter().flatten().any(|k| k["kind"].is_null() || k["kind"] == "build")
+            })
+            .filter_map(|d| d["pkg"].as_str().and_then(|id| names.get(id)).map(|n| n.to_string()))
+            .collect();
+        graph.insert(name.to_string(), deps);
+    }
+    graph
+}
+
+fn transitive(graph: &HashMap<String, Vec<String>>, root: &str) -> BTreeSet<String> {
+    let mut seen = BTreeSet::new();
+    let mut stack = vec![root.to_string()];
+    while let Some(n) = stack.pop() {
+        for d in graph.get(&n).into_iter().flatten() {
+            if seen.insert(d.clone()) {
+                stack.push(d.clone());
+            }
+        }
+    }
+    seen
+}
+
+const OURS: [&str; 7] = [
+    "envmap-sphere",
+    "light-extract",
+    "shaft-hierarchy",
+    "shadowmap-paraboloid",
+    "penumbra-wedge",
+    "differential-composite",
+    "ref-tracer",
+];
+
+#[test]
+fn envmap_sphere_depends_on_no_crate_of_ours() {
+    let graph = dependency_graph();
+    // Not vacuous: the graph does see our own edges.
+    assert!(transitive(&graph, "xtask").contains("envmap-sphere"), "xtask -> envmap-sphere missing");
+    let deps = transitive(&graph, "envmap-sphere");
+    let ours: Vec<_> = deps.iter().filter(|d| OURS.contains(&d.as_str()) || *d == "scene" || *d == "gpu").collect();
+    assert!(ours.is_empty(), "envmap-sphere depends on {ours:?}");
+}
+
+#[test]
+fn light_extract_and_ref_tracer_never_touch_wgpu() {
+    let graph = dependency_graph();
+    for krate in ["light-extract", "ref-tracer", "envmap-sphere"] {
+        assert!(graph.contains_key(krate), "{krate} not in the workspace");
+        let deps = transitive(&graph, krate);
+        let gpu: Vec<_> = deps.iter().filter(|d| d.starts_with("wgpu") || *d == "ash" || *d == "naga").collect();
+        assert!(gpu.is_empty(), "{krate} depends on {gpu:?}");
+    }
+}

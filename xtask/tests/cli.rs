@@ -1,0 +1,77 @@
+//! The commands as a user runs them: output shape, exit codes, one-line errors.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn xtask(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_xtask")).args(args).output().expect("run xtask")
+}
+
+fn shared(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/envmaps").join(name)
+}
+
+#[test]
+fn info_json_has_the_documented_keys_and_values() {
+    let path = shared("city.exr");
+    let out = xtask(&["info", path.to_str().unwrap_or_default(), "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(text.trim().lines().count(), 1, "one JSON object on one line: {text}");
+    let v: serde_json::Value = serde_json::from_str(&text).expect("valid JSON");
+    let keys: Vec<&str> = v.as_object().expect("an object").keys().map(String::as_str).collect();
+    for k in ["width", "height", "format", "compression", "max_luminance", "mean_luminance", "power", "sh9"] {
+        assert!(keys.contains(&k), "missing key {k} in {keys:?}");
+    }
+    assert_eq!((v["width"].as_u64(), v["height"].as_u64()), (Some(1024), Some(512)));
+    assert_eq!((v["format"].as_str(), v["compression"].as_str()), (Some("exr"), Some("dwab")));
+    assert!((v["max_luminance"].as_f64().unwrap_or(0.0) - 31749.4).abs() < 1.0);
+    assert!((v["mean_luminance"].as_f64().unwrap_or(0.0) - 1.055).abs() < 0.01);
+    let power = v["power"].as_array().expect("power array");
+    assert_eq!(power.len(), 3);
+    let sh9 = v["sh9"].as_array().expect("sh9 array");
+    assert!(sh9.len() == 9 && sh9.iter().all(|c| c.as_array().is_some_and(|c| c.len() == 3)));
+    // sh9[0] = integral of L * Y00 = power * 0.2820948
+    let p0 = power[0].as_f64().unwrap_or(0.0);
+    let c0 = sh9[0][0].as_f64().unwrap_or(0.0);
+    assert!((c0 / (p0 * 0.282_094_8) - 1.0).abs() < 1e-4, "{c0} vs {p0}");
+}
+
+#[test]
+fn info_text_lists_the_statistics() {
+    let path = shared("venice_sunset_1k.hdr");
+    let out = xtask(&["info", path.to_str().unwrap_or_default()]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    for needle in ["1024 x 512", "hdr (rle)", "max 2090.", "power", "sh9 l2 m2"] {
+        assert!(text.contains(needle), "missing {needle:?} in:\n{text}");
+    }
+}
+
+#[test]
+fn bad_input_exits_one_with_one_line_naming_the_file() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli-bad");
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let text = dir.join("text.hdr");
+    std::fs::write(&text, "hello").expect("write");
+    for path in [dir.join("missing.exr"), text] {
+        let p = path.to_str().unwrap_or_default();
+        for args in [vec!["info", p], vec!["info", p, "--json"], vec!["validate", "--envmap", p]] {
+            let out = xtask(&args);
+            assert_eq!(out.status.code(), Some(1), "{args:?}");
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(err.trim().lines().count(), 1, "{args:?}: {err}");
+            assert!(err.contains(p), "{args:?}: {err}");
+            assert!(out.stdout.is_empty() || args[0] == "validate", "{args:?}");
+        }
+    }
+}
+
+#[test]
+fn validate_runs_on_the_embedded_default_map() {
+    let out = xtask(&["validate"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("city.exr (embedded default") && text.contains("1024 x 512"), "{text}");
+    assert!(text.contains("clamped       506 negative values"), "{text}");
+}
