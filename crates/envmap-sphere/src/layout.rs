@@ -129,16 +129,7 @@ impl Layout {
             }
             Self::Paraboloid { .. } | Self::DualParaboloid { .. } => {
                 const N: u32 = 4;
-                let mut sum = 0.0;
-                for b in 0..N {
-                    for a in 0..N {
-                        let uv = Vec2::new(
-                            (x as f32 + (a as f32 + 0.5) / N as f32) / w as f32,
-                            (y as f32 + (b as f32 + 0.5) / N as f32) / h as f32,
-                        );
-                        sum += f64::from(self.jacobian(uv));
-                    }
-                }
+                let sum: f64 = subtexel_uvs(x, y, N, (w, h)).map(|uv| f64::from(self.jacobian(uv))).sum();
                 sum / f64::from(N * N) / (f64::from(w) * f64::from(h))
             }
         }
@@ -151,6 +142,17 @@ impl Layout {
         let k = x.floor();
         (k as usize, Vec2::new(x - k, uv.y))
     }
+}
+
+/// Image coordinates of the centres of an `n` x `n` grid of sub-texels of texel (x, y).
+fn subtexel_uvs(x: u32, y: u32, n: u32, (w, h): (u32, u32)) -> impl Iterator<Item = Vec2> {
+    (0..n * n).map(move |k| {
+        let (a, b) = (k % n, k / n);
+        Vec2::new(
+            (x as f32 + (a as f32 + 0.5) / n as f32) / w as f32,
+            (y as f32 + (b as f32 + 0.5) / n as f32) / h as f32,
+        )
+    })
 }
 
 /// Disk point of tile coordinates: p = (2s - 1, 1 - 2t).
@@ -297,17 +299,11 @@ fn resample_texel(src: &impl RadianceSource, layout: &Layout, x: u32, y: u32) ->
     }
     let mut sum = Vec3::ZERO;
     let mut weight = 0.0;
-    for b in 0..n {
-        for a in 0..n {
-            let uv = Vec2::new(
-                (x as f32 + (a as f32 + 0.5) / n as f32) / w as f32,
-                (y as f32 + (b as f32 + 0.5) / n as f32) / h as f32,
-            );
-            if let Some(d) = layout.uv_to_dir(uv) {
-                let wgt = layout.jacobian(uv);
-                sum += src.radiance(d) * wgt;
-                weight += wgt;
-            }
+    for uv in subtexel_uvs(x, y, n, (w, h)) {
+        if let Some(d) = layout.uv_to_dir(uv) {
+            let wgt = layout.jacobian(uv);
+            sum += src.radiance(d) * wgt;
+            weight += wgt;
         }
     }
     if weight > 0.0 { sum / weight } else { src.radiance(dir) }
