@@ -79,7 +79,7 @@ fn envmap_sphere_depends_on_no_crate_of_ours() {
 #[test]
 fn light_extract_and_ref_tracer_never_touch_wgpu() {
     let graph = dependency_graph();
-    for krate in ["light-extract", "ref-tracer", "envmap-sphere"] {
+    for krate in ["light-extract", "ref-tracer", "envmap-sphere", "scene"] {
         assert!(graph.contains_key(krate), "{krate} not in the workspace");
         let deps = transitive(&graph, krate);
         let gpu: Vec<_> = deps.iter().filter(|d| d.starts_with("wgpu") || *d == "ash" || *d == "naga").collect();

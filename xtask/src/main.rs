@@ -5,6 +5,7 @@
 
 mod info;
 mod lavapipe;
+mod scene;
 mod test;
 mod validate;
 
@@ -34,6 +35,14 @@ enum Command {
         #[arg(last = true)]
         args: Vec<String>,
     },
+    /// Write a built-in scene's geometry (spheres_box, three_boxes, column, glossy_set, room).
+    Scene {
+        /// The scene's name.
+        name: String,
+        /// Output Wavefront OBJ file: one `o` per object, materials in comments.
+        #[arg(long)]
+        obj: PathBuf,
+    },
     /// Print an environment map's size, format, luminance, power and SH9 coefficients.
     Info {
         /// The map (.exr or .hdr).
@@ -50,6 +59,7 @@ fn main() -> ExitCode {
         Command::Validate { envmap } => validate::run(envmap.as_deref()),
         Command::Test { args } => test::run(&args),
         Command::Info { path, json } => info::run(&path, json),
+        Command::Scene { name, obj } => scene::run(&name, &obj),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -75,3 +75,19 @@ fn validate_runs_on_the_embedded_default_map() {
     assert!(text.contains("city.exr (embedded default") && text.contains("1024 x 512"), "{text}");
     assert!(text.contains("clamped       506 negative values"), "{text}");
 }
+
+#[test]
+fn scene_writes_obj_and_refuses_unknown_names() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli-scene");
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let obj = dir.join("spheres_box.obj");
+    let out = xtask(&["scene", "spheres_box", "--obj", obj.to_str().unwrap_or_default()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("20494 triangles"));
+    let text = std::fs::read_to_string(&obj).expect("OBJ written");
+    assert_eq!(text.lines().filter(|l| l.starts_with("o ")).count(), 3);
+    assert_eq!(text.lines().filter(|l| l.starts_with("f ")).count(), 20_494);
+    let out = xtask(&["scene", "teapot", "--obj", obj.to_str().unwrap_or_default()]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("unknown scene \"teapot\""));
+}

@@ -1,0 +1,89 @@
+//! Scenes shared by the CPU reference (`ref-tracer`) and the GPU renderers: triangle meshes with
+//! one material per object, a pinhole camera, and the procedural built-in scenes (no asset
+//! files), exportable as Wavefront OBJ so another renderer can render exactly the same geometry.
+//!
+//! ```
+//! let scene = scene::Scene::builtin("spheres_box").expect("a built-in scene");
+//! assert_eq!(scene.objects.len(), 3);
+//! let (origin, dir) = scene.camera.ray(320.0, 240.0);
+//! assert!((dir.length() - 1.0).abs() < 1e-6 && origin == scene.camera.eye);
+//! ```
+
+mod builtin;
+mod camera;
+mod material;
+mod mesh;
+mod obj;
+
+pub use builtin::BUILTIN_SCENES;
+pub use camera::Camera;
+pub use material::{Ggx, Material};
+pub use mesh::Mesh;
+
+use glam::Vec3;
+
+/// One object: a mesh and its material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Object {
+    /// Name, unique within the scene (the OBJ `o` name).
+    pub name: String,
+    /// Geometry in world space.
+    pub mesh: Mesh,
+    /// Surface material.
+    pub material: Material,
+}
+
+/// A point light (used by the `room` scene).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointLight {
+    /// Position in metres.
+    pub position: Vec3,
+    /// Radiant intensity, W/sr per channel.
+    pub intensity: Vec3,
+}
+
+/// A scene: objects, a camera, and optional point lights. Environment lighting comes from the map.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    /// Name of the scene.
+    pub name: String,
+    /// The objects.
+    pub objects: Vec<Object>,
+    /// The view.
+    pub camera: Camera,
+    /// Point lights, if the scene has any.
+    pub point_lights: Vec<PointLight>,
+}
+
+/// Errors of this crate.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// No built-in scene of that name.
+    #[error("unknown scene {name:?}; built-in scenes: {}", BUILTIN_SCENES.join(", "))]
+    Unknown {
+        /// The name asked for.
+        name: String,
+    },
+    /// Writing a file failed.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: std::path::PathBuf,
+        /// What the operating system said.
+        source: std::io::Error,
+    },
+}
+
+impl Scene {
+    /// Total number of triangles.
+    #[must_use]
+    pub fn triangle_count(&self) -> usize {
+        self.objects.iter().map(|o| o.mesh.indices.len()).sum()
+    }
+
+    /// The object called `name`.
+    #[must_use]
+    pub fn object(&self, name: &str) -> Option<&Object> {
+        self.objects.iter().find(|o| o.name == name)
+    }
+}
