@@ -9,14 +9,17 @@
 //! assert!((dir.length() - 1.0).abs() < 1e-6 && origin == scene.camera.eye);
 //! ```
 
+pub mod brdf;
 mod builtin;
 mod camera;
+mod light;
 mod material;
 mod mesh;
 mod obj;
 
 pub use builtin::BUILTIN_SCENES;
 pub use camera::Camera;
+pub use light::DistantLight;
 pub use material::{Ggx, Material};
 pub use mesh::Mesh;
 

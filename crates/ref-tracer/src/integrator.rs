@@ -1,0 +1,232 @@
+//! The integrators: radiance along one camera ray.
+//!
+//! - `EnvDirect`: direct illumination from the map, multiple importance sampling of one map
+//!   sample and one BRDF sample with the power heuristic; the truth approximations are measured
+//!   against. `Strategy` isolates either technique for tests.
+//! - `Lights`: direct illumination from distant cone lights with ray-traced visibility, plus an
+//!   SH9 ambient term (unshadowed, or shadowed by cosine-sampled visibility).
+//! - `Path`: multi-bounce path tracing with the same MIS next-event estimation at every vertex.
+//!
+//! Surfaces do not emit; the map is the only light of `EnvDirect` and `Path`.
+
+use crate::bvh::{SceneBvh, SurfacePoint};
+use crate::sampler::PixelSampler;
+use envmap_sphere::{EnvDistribution, EnvMap, Sh9};
+use glam::Vec3;
+use scene::DistantLight;
+use scene::brdf::Frame;
+
+/// Which sampling techniques `EnvDirect` combines.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Strategy {
+    /// One map sample and one BRDF sample, power heuristic.
+    #[default]
+    Mis,
+    /// Map sampling only.
+    EnvOnly,
+    /// BRDF sampling only.
+    BrdfOnly,
+}
+
+/// The environment as a light: radiance (bilinear, like Mitsuba's `envmap`) and its sampler.
+pub struct EnvLight<'a> {
+    /// The map.
+    pub map: &'a EnvMap,
+    /// Its importance sampling distribution.
+    pub dist: EnvDistribution,
+}
+
+impl<'a> EnvLight<'a> {
+    /// Builds the sampling distribution of `map`.
+    #[must_use]
+    pub fn new(map: &'a EnvMap) -> Self {
+        Self { map, dist: EnvDistribution::new(map) }
+    }
+}
+
+/// Extracted lights plus ambient, for the `Lights` integrator.
+pub struct LightSet<'a> {
+    /// Distant cone lights.
+    pub lights: &'a [DistantLight],
+    /// Ambient radiance as SH9 (its irradiance lights the diffuse lobe), if any.
+    pub ambient: Option<Sh9>,
+    /// Shadow the ambient term by sampling visibility (cosine-weighted) instead of leaving it
+    /// unshadowed.
+    pub shadow_ambient: bool,
+    /// What camera rays that miss see (the original map, usually).
+    pub background: Option<&'a EnvMap>,
+}
+
+/// An integrator and its parameters.
+pub enum Integrator<'a> {
+    /// Direct illumination from the map.
+    EnvDirect(Strategy),
+    /// Direct illumination from extracted lights.
+    Lights(LightSet<'a>),
+    /// Path tracing; `max_depth` = 1 is direct illumination only.
+    Path {
+        /// Number of scattering events with next-event estimation.
+        max_depth: u32,
+    },
+}
+
+fn power_heuristic(a: f32, b: f32) -> f32 {
+    let (a2, b2) = (a * a, b * b);
+    if a2 + b2 == 0.0 { 0.0 } else { a2 / (a2 + b2) }
+}
+
+/// Everything an estimator needs at a surface point.
+struct Shading<'a> {
+    p: Vec3,
+    ng: Vec3,
+    frame: Frame,
+    wo: Vec3,
+    material: &'a scene::Material,
+    eps: f32,
+}
+
+impl Shading<'_> {
+    fn new<'b>(bvh: &'b SceneBvh, sp: &SurfacePoint, ray_dir: Vec3) -> Shading<'b> {
+        let frame = Frame::new(sp.shading_normal);
+        Shading {
+            p: sp.position,
+            ng: sp.geometric_normal,
+            wo: frame.to_local(-ray_dir),
+            frame,
+            material: bvh.material(sp.object),
+            eps: bvh.epsilon(),
+        }
+    }
+
+    /// f * cos for a world direction, zero when it leaves below the geometric surface.
+    fn f_cos(&self, wi_world: Vec3) -> (Vec3, Vec3) {
+        let wi = self.frame.to_local(wi_world);
+        if wi_world.dot(self.ng) <= 0.0 || wi.z <= 0.0 {
+            return (Vec3::ZERO, wi);
+        }
+        (self.material.eval_brdf(self.wo, wi) * wi.z, wi)
+    }
+
+    fn origin(&self) -> Vec3 {
+        self.p + self.ng * self.eps
+    }
+}
+
+impl Integrator<'_> {
+    /// Radiance arriving along the camera ray `(origin, dir)`.
+    #[must_use]
+    pub fn radiance(
+        &self,
+        bvh: &SceneBvh,
+        env: Option<&EnvLight>,
+        origin: Vec3,
+        dir: Vec3,
+        s: &mut PixelSampler,
+    ) -> Vec3 {
+        match self {
+            Self::EnvDirect(strategy) => {
+                let env = env.expect("EnvDirect needs the map");
+                match bvh.intersect(origin, dir, f32::INFINITY) {
+                    None => env.map.lookup(dir),
+                    Some(sp) => env_direct(bvh, env, &Shading::new(bvh, &sp, dir), *strategy, s).0,
+                }
+            }
+            Self::Lights(set) => match bvh.intersect(origin, dir, f32::INFINITY) {
+                None => set.background.map_or(Vec3::ZERO, |m| m.lookup(dir)),
+                Some(sp) => lights_direct(bvh, set, &Shading::new(bvh, &sp, dir), s),
+            },
+            Self::Path { max_depth } => path(bvh, env.expect("Path needs the map"), origin, dir, *max_depth, s),
+        }
+    }
+}
+
+/// One MIS estimate of direct light from the map; also returns the BRDF-sampled continuation
+/// (direction, f cos / pdf, pdf, whether it escaped) for path tracing to reuse.
+fn env_direct(
+    bvh: &SceneBvh,
+    env: &EnvLight,
+    sh: &Shading,
+    strategy: Strategy,
+    s: &mut PixelSampler,
+) -> (Vec3, Option<(Vec3, Vec3, f32)>) {
+    let mut l = Vec3::ZERO;
+    let u_env = s.next_2d();
+    let (u_brdf, u_lobe) = (s.next_2d(), s.next_1d());
+    if strategy != Strategy::BrdfOnly {
+        let ls = env.dist.sample_dir(u_env);
+        let (fc, wi) = sh.f_cos(ls.dir);
+        if ls.pdf > 0.0 && fc != Vec3::ZERO && !bvh.occluded(sh.origin(), ls.dir, f32::INFINITY) {
+            let w =
+                if strategy == Strategy::Mis { power_heuristic(ls.pdf, sh.material.brdf_pdf(sh.wo, wi)) } else { 1.0 };
+            l += fc * env.map.lookup(ls.dir) * (w / ls.pdf);
+        }
+    }
+    let mut next = None;
+    if let Some((wi, pdf)) = sh.material.sample_brdf(sh.wo, u_brdf, u_lobe) {
+        let wi_world = sh.frame.to_world(wi);
+        let (fc, _) = sh.f_cos(wi_world);
+        if fc != Vec3::ZERO {
+            next = Some((wi_world, fc / pdf, pdf));
+            if strategy != Strategy::EnvOnly && !bvh.occluded(sh.origin(), wi_world, f32::INFINITY) {
+                let w = if strategy == Strategy::Mis { power_heuristic(pdf, env.dist.dir_pdf(wi_world)) } else { 1.0 };
+                l += fc * env.map.lookup(wi_world) * (w / pdf);
+            }
+        }
+    }
+    (l, next)
+}
+
+fn lights_direct(bvh: &SceneBvh, set: &LightSet, sh: &Shading, s: &mut PixelSampler) -> Vec3 {
+    let mut l = Vec3::ZERO;
+    for light in set.lights {
+        let (dir, pdf) = light.sample_direction(s.next_2d());
+        let (fc, _) = sh.f_cos(dir);
+        if fc != Vec3::ZERO && !bvh.occluded(sh.origin(), dir, f32::INFINITY) {
+            l += fc * light.radiance / pdf;
+        }
+    }
+    if let Some(sh9) = &set.ambient {
+        let diffuse = sh.material.albedo * sh.material.diffuse_weight();
+        if set.shadow_ambient {
+            // cosine sampling: estimate of albedo/pi * integral L V cos = albedo * L(wi) V
+            let wi = sh.frame.to_world(scene::brdf::sample_cosine_hemisphere(s.next_2d()));
+            if wi.dot(sh.ng) > 0.0 && !bvh.occluded(sh.origin(), wi, f32::INFINITY) {
+                l += diffuse * sh9.eval(wi).max(Vec3::ZERO);
+            }
+        } else {
+            l += diffuse * sh9.irradiance(sh.frame.n).max(Vec3::ZERO) * std::f32::consts::FRAC_1_PI;
+        }
+    }
+    l
+}
+
+fn path(bvh: &SceneBvh, env: &EnvLight, origin: Vec3, dir: Vec3, max_depth: u32, s: &mut PixelSampler) -> Vec3 {
+    let (mut l, mut beta) = (Vec3::ZERO, Vec3::ONE);
+    let (mut o, mut d) = (origin, dir);
+    for depth in 0..max_depth {
+        let Some(sp) = bvh.intersect(o, d, f32::INFINITY) else {
+            if depth == 0 {
+                l += env.map.lookup(d);
+            }
+            break;
+        };
+        let sh = Shading::new(bvh, &sp, d);
+        // NEE with MIS; the BRDF-sampled escape is counted inside env_direct, so the path
+        // continues only through hits.
+        let (direct, next) = env_direct(bvh, env, &sh, Strategy::Mis, s);
+        l += beta * direct;
+        let Some((wi, weight, _)) = next else { break };
+        beta *= weight;
+        if depth >= 3 {
+            // Russian roulette
+            let q = beta.max_element().min(0.95);
+            if s.next_1d() >= q {
+                break;
+            }
+            beta /= q;
+        }
+        o = sh.origin();
+        d = wi;
+    }
+    l
+}

@@ -1,0 +1,135 @@
+//! Rendering an image: rayon over 16 x 16 tiles, passes of samples until the sample count or
+//! the time budget is reached, and the AOVs of each pixel's centre ray.
+
+use crate::bvh::SceneBvh;
+use crate::integrator::{EnvLight, Integrator};
+use crate::sampler::PixelSampler;
+use glam::Vec3;
+use rayon::prelude::*;
+use scene::Scene;
+use std::time::{Duration, Instant};
+
+const TILE: u32 = 16;
+
+/// Render settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RenderSettings {
+    /// Samples per pixel (the most, with a time budget).
+    pub spp: u32,
+    /// Seed: the same seed gives the same image bits for any thread count.
+    pub seed: u64,
+    /// Stop after the first pass that ends past this budget (the image then has fewer spp).
+    pub time_budget: Option<Duration>,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self { spp: 16, seed: 0, time_budget: None }
+    }
+}
+
+/// A rendered image with its AOVs.
+#[derive(Clone, Debug)]
+pub struct Render {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Linear RGB radiance, the plain mean of each pixel's samples (box filter).
+    pub color: Vec<Vec3>,
+    /// AOV: diffuse albedo of the first hit (zero for the background).
+    pub albedo: Vec<Vec3>,
+    /// AOV: unit shading normal of the first hit, facing the camera (zero for the background).
+    pub normal: Vec<Vec3>,
+    /// AOV: distance from the eye to the first hit along the centre ray (infinity for the background).
+    pub depth: Vec<f32>,
+    /// AOV: index of the first hit's object (`u32::MAX` for the background).
+    pub object_id: Vec<u32>,
+    /// Samples per pixel actually taken.
+    pub spp: u32,
+    /// Wall time of the sampling passes.
+    pub seconds: f64,
+}
+
+/// Renders `scene` with `integrator`. `progress` is called after each pass with
+/// (samples done, samples planned) per pixel.
+#[must_use]
+pub fn render(
+    scene: &Scene,
+    bvh: &SceneBvh,
+    env: Option<&EnvLight>,
+    integrator: &Integrator,
+    settings: &RenderSettings,
+    progress: &(dyn Fn(u32, u32) + Sync),
+) -> Render {
+    let cam = scene.camera;
+    let (w, h) = (cam.width, cam.height);
+    let n = (w * h) as usize;
+    let start = Instant::now();
+    let tiles: Vec<(u32, u32)> =
+        (0..h.div_ceil(TILE)).flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE))).collect();
+    let mut sum = vec![Vec3::ZERO; n];
+    let pass_size = (settings.spp / 16).max(1);
+    let mut done = 0u32;
+    while done < settings.spp {
+        let count = pass_size.min(settings.spp - done);
+        let results: Vec<Vec<(usize, Vec3)>> = tiles
+            .par_iter()
+            .map(|&(x0, y0)| {
+                let mut out = Vec::with_capacity((TILE * TILE) as usize);
+                for y in y0..(y0 + TILE).min(h) {
+                    for x in x0..(x0 + TILE).min(w) {
+                        let pixel = (y * w + x) as usize;
+                        let mut acc = Vec3::ZERO;
+                        for k in done..done + count {
+                            let mut s = PixelSampler::new(settings.seed, pixel as u64, u64::from(k));
+                            let j = s.next_2d();
+                            let (o, d) = cam.ray(x as f32 + j.x, y as f32 + j.y);
+                            acc += integrator.radiance(bvh, env, o, d, &mut s);
+                        }
+                        out.push((pixel, acc));
+                    }
+                }
+                out
+            })
+            .collect();
+        for (pixel, acc) in results.into_iter().flatten() {
+            sum[pixel] += acc;
+        }
+        done += count;
+        progress(done, settings.spp);
+        if settings.time_budget.is_some_and(|b| start.elapsed() >= b) {
+            break;
+        }
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    let color = sum.into_iter().map(|s| s / done as f32).collect();
+    let mut r = Render {
+        width: w,
+        height: h,
+        color,
+        albedo: vec![Vec3::ZERO; n],
+        normal: vec![Vec3::ZERO; n],
+        depth: vec![f32::INFINITY; n],
+        object_id: vec![u32::MAX; n],
+        spp: done,
+        seconds,
+    };
+    let aovs: Vec<_> = (0..n)
+        .into_par_iter()
+        .map(|pixel| {
+            let (x, y) = ((pixel as u32 % w) as f32 + 0.5, (pixel as u32 / w) as f32 + 0.5);
+            let (o, d) = cam.ray(x, y);
+            bvh.intersect(o, d, f32::INFINITY).map(|sp| (sp, bvh.material(sp.object).albedo))
+        })
+        .collect();
+    for (pixel, aov) in aovs.into_iter().enumerate() {
+        if let Some((sp, albedo)) = aov {
+            r.albedo[pixel] = albedo;
+            r.normal[pixel] = sp.shading_normal;
+            r.depth[pixel] = sp.t;
+            r.object_id[pixel] = sp.object;
+        }
+    }
+    r
+}
