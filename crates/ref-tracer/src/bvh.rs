@@ -7,7 +7,7 @@ use obvhs::cwbvh::CwBvh;
 use obvhs::cwbvh::builder::build_cwbvh_from_tris;
 use obvhs::ray::{Ray, RayHit};
 use obvhs::triangle::Triangle;
-use scene::{Material, Scene};
+use scene::{Material, Mesh, Scene};
 
 /// A ray's closest hit, resolved to a surface point.
 #[derive(Clone, Copy, Debug)]
@@ -32,8 +32,8 @@ pub struct SceneBvh {
     /// per triangle: (object, triangle within the object)
     owners: Vec<(u32, u32)>,
     materials: Vec<Material>,
-    /// per object: the vertex normals, if any, with the object's index buffer
-    shading: Vec<Option<(Vec<Vec3>, Vec<[u32; 3]>)>>,
+    /// per object: its mesh, for interpolating vertex normals
+    meshes: Vec<Mesh>,
     scale: f32,
 }
 
@@ -108,10 +108,11 @@ impl SceneBvh {
         let position = origin + dir * t;
         let mut ng = (v1 - v0).cross(v2 - v0).normalize_or(Vec3::Y);
         let (object, local) = self.owners[tri_index];
-        let mut ns = match &self.shading[object as usize] {
-            Some((normals, indices)) => {
+        let mesh = &self.meshes[object as usize];
+        let mut ns = match &mesh.normals {
+            Some(normals) => {
                 let b = barycentric(Vec3A::from(position), tri);
-                let [i0, i1, i2] = indices[local as usize].map(|i| normals[i as usize]);
+                let [i0, i1, i2] = mesh.indices[local as usize].map(|i| normals[i as usize]);
                 (i0 * b.x + i1 * b.y + i2 * b.z).normalize_or(ng)
             }
             None => ng,
