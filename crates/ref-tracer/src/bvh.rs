@@ -58,11 +58,7 @@ impl SceneBvh {
             triangles,
             owners,
             materials: scene.objects.iter().map(|o| o.material).collect(),
-            shading: scene
-                .objects
-                .iter()
-                .map(|o| o.mesh.normals.clone().map(|n| (n, o.mesh.indices.clone())))
-                .collect(),
+            meshes: scene.objects.iter().map(|o| o.mesh.clone()).collect(),
             scale,
         }
     }
