@@ -133,8 +133,42 @@ impl EnvDistribution {
     #[must_use]
     pub fn new(map: &EnvMap) -> Self {
         let (w, h) = (map.width(), map.height());
+        let lum: Vec<f64> = map.pixels().iter().map(|p| f64::from(luminance(*p)).max(0.0)).collect();
+        Self::from_weights(map, &lum, w, h)
+    }
+
+    /// A distribution for renderers that evaluate the map bilinearly ([`EnvMap::lookup`]): each
+    /// texel's weight is the largest luminance in its 3 x 3 neighbourhood (wrapping in u,
+    /// clamped in v). A bilinear value inside a texel mixes only texels of that neighbourhood,
+    /// so radiance / pdf stays bounded: no fireflies next to a one-texel sun, at the price of
+    /// spreading the sun's samples over its neighbours.
+    #[must_use]
+    pub fn for_bilinear(map: &EnvMap) -> Self {
+        let (w, h) = (map.width(), map.height());
+        let lum = |i: i64, j: i64| {
+            let i = i.rem_euclid(i64::from(w)) as u32;
+            let j = j.clamp(0, i64::from(h) - 1) as u32;
+            f64::from(luminance(map.pixel(i, j))).max(0.0)
+        };
+        let weights: Vec<f64> = (0..i64::from(h))
+            .flat_map(|j| (0..i64::from(w)).map(move |i| (i, j)))
+            .map(|(i, j)| {
+                let mut m = 0.0f64;
+                for dj in -1..=1 {
+                    for di in -1..=1 {
+                        m = m.max(lum(i + di, j + dj));
+                    }
+                }
+                m
+            })
+            .collect();
+        Self::from_weights(map, &weights, w, h)
+    }
+
+    /// The distribution of per-texel weights (row-major, non-negative) x texel solid angle.
+    fn from_weights(map: &EnvMap, lum: &[f64], w: u32, h: u32) -> Self {
         let sa: Vec<f64> = map.row_solid_angles();
-        let lum = |i: u32, j: u32| f64::from(luminance(map.pixel(i, j))).max(0.0);
+        let lum = |i: u32, j: u32| lum[j as usize * w as usize + i as usize];
         let total: f64 = (0..h).map(|j| (0..w).map(|i| lum(i, j)).sum::<f64>() * sa[j as usize]).sum();
         let black = !(total.is_finite() && total > 0.0);
         let weight = |i: u32, j: u32| if black { sa[j as usize] } else { lum(i, j) * sa[j as usize] };

@@ -143,16 +143,7 @@ impl EnvMap {
         options: &LoadOptions,
     ) -> Result<(Self, LoadReport), EnvMapError> {
         let path = name.as_ref().to_path_buf();
-        if bytes.is_empty() {
-            return Err(EnvMapError::Empty { path });
-        }
-        let (width, height, mut pixels, format, compression) = if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
-            decode_exr(bytes, &path, options)?
-        } else if bytes.starts_with(b"#?") {
-            decode_hdr(bytes, &path, options)?
-        } else {
-            return Err(EnvMapError::UnknownFormat { path });
-        };
+        let (width, height, mut pixels, format, compression) = decode(bytes, &path, options, true)?;
         let mut report = LoadReport {
             format,
             compression,
@@ -230,7 +221,52 @@ pub fn save_png_rgb(
 
 type Decoded = (u32, u32, Vec<Vec3>, FileFormat, String);
 
-fn check_size(path: &Path, w: u64, h: u64, options: &LoadOptions) -> Result<(u32, u32), EnvMapError> {
+fn decode(bytes: &[u8], path: &Path, options: &LoadOptions, latlong: bool) -> Result<Decoded, EnvMapError> {
+    if bytes.is_empty() {
+        Err(EnvMapError::Empty { path: path.to_path_buf() })
+    } else if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
+        decode_exr(bytes, path, options, latlong)
+    } else if bytes.starts_with(b"#?") {
+        decode_hdr(bytes, path, options, latlong)
+    } else {
+        Err(EnvMapError::UnknownFormat { path: path.to_path_buf() })
+    }
+}
+
+/// A plain linear RGB image (a render, not a map): row-major, row 0 at the top.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RgbImage {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Row-major pixels.
+    pub pixels: Vec<Vec3>,
+}
+
+/// Loads an .exr or .hdr image of any aspect ratio as it is: no lat-long check, no policy on
+/// negative values; NaN and infinity are refused and sizes are checked as for maps.
+///
+/// # Errors
+/// As [`EnvMap::load_with`], without [`EnvMapError::NotLatLong`] and [`EnvMapError::Negative`].
+pub fn load_rgb_image(path: impl AsRef<Path>) -> Result<RgbImage, EnvMapError> {
+    let path = path.as_ref();
+    let bytes = std::fs::read(path).map_err(|e| EnvMapError::io(path, e))?;
+    let options = LoadOptions::default();
+    let (width, height, pixels, _, _) = decode(&bytes, path, &options, false)?;
+    if let Some(k) = pixels.iter().position(|p| !p.is_finite()) {
+        let count = pixels.iter().map(|p| p.to_array().iter().filter(|c| !c.is_finite()).count()).sum();
+        return Err(EnvMapError::NonFinite {
+            path: path.to_path_buf(),
+            count,
+            first_i: (k % width as usize) as u32,
+            first_j: (k / width as usize) as u32,
+        });
+    }
+    Ok(RgbImage { width, height, pixels })
+}
+
+fn check_size(path: &Path, w: u64, h: u64, options: &LoadOptions, latlong: bool) -> Result<(u32, u32), EnvMapError> {
     let path = path.to_path_buf();
     if w == 0 || h == 0 {
         return Err(EnvMapError::InvalidSize { path, width: w, height: h });
@@ -238,19 +274,19 @@ fn check_size(path: &Path, w: u64, h: u64, options: &LoadOptions) -> Result<(u32
     if w.saturating_mul(h) > options.max_pixels || w > u64::from(u32::MAX) || h > u64::from(u32::MAX) {
         return Err(EnvMapError::TooLarge { path, width: w, height: h, limit: options.max_pixels });
     }
-    if w < h || w > 4 * h {
+    if latlong && (w < h || w > 4 * h) {
         return Err(EnvMapError::NotLatLong { path, width: w, height: h });
     }
     Ok((w as u32, h as u32))
 }
 
-fn decode_exr(bytes: &[u8], path: &Path, options: &LoadOptions) -> Result<Decoded, EnvMapError> {
+fn decode_exr(bytes: &[u8], path: &Path, options: &LoadOptions, latlong: bool) -> Result<Decoded, EnvMapError> {
     use exr::prelude::*;
     let err = |reason: String| EnvMapError::Decode { path: path.to_path_buf(), format: "OpenEXR", reason };
     let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false).map_err(|e| err(e.to_string()))?;
     let header = meta.headers.first().ok_or_else(|| err("no layers".into()))?;
     let size = header.layer_size;
-    let (w, h) = check_size(path, size.width() as u64, size.height() as u64, options)?;
+    let (w, h) = check_size(path, size.width() as u64, size.height() as u64, options, latlong)?;
     let compression = format!("{:?}", header.compression);
     let compression = compression.split('(').next().unwrap_or("").to_lowercase();
     let compression = if compression == "uncompressed" { "none".to_string() } else { compression };
@@ -279,12 +315,12 @@ fn decode_exr(bytes: &[u8], path: &Path, options: &LoadOptions) -> Result<Decode
     Ok((w, h, pixels, FileFormat::Exr, compression))
 }
 
-fn decode_hdr(bytes: &[u8], path: &Path, options: &LoadOptions) -> Result<Decoded, EnvMapError> {
+fn decode_hdr(bytes: &[u8], path: &Path, options: &LoadOptions, latlong: bool) -> Result<Decoded, EnvMapError> {
     use image::ImageDecoder;
     let err = |reason: String| EnvMapError::Decode { path: path.to_path_buf(), format: "Radiance HDR", reason };
     let decoder = image::codecs::hdr::HdrDecoder::new(Cursor::new(bytes)).map_err(|e| err(e.to_string()))?;
     let (w, h) = decoder.dimensions();
-    let (w, h) = check_size(path, u64::from(w), u64::from(h), options)?;
+    let (w, h) = check_size(path, u64::from(w), u64::from(h), options, latlong)?;
     let mut buf = vec![0u8; decoder.total_bytes() as usize];
     decoder.read_image(&mut buf).map_err(|e| err(e.to_string()))?;
     let pixels = buf

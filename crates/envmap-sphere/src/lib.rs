@@ -51,7 +51,7 @@ pub use distribution::{DirSample, Distribution1D, EnvDistribution};
 pub use envmap::{EnvMap, texel_centre_dir};
 pub use error::EnvMapError;
 pub use integrate::LuminanceStats;
-pub use io::{FileFormat, LoadOptions, LoadReport, NegativePolicy, NonFinitePolicy};
+pub use io::{FileFormat, LoadOptions, LoadReport, NegativePolicy, NonFinitePolicy, RgbImage, load_rgb_image};
 pub use layout::{Layout, RadianceSource, SphereImage};
 pub use sat::SummedAreaTable;
 pub use sh::Sh9;

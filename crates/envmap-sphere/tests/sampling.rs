@@ -29,18 +29,19 @@ fn test_map() -> EnvMap {
 #[test]
 fn pdf_integrates_to_one() {
     for map in [test_map(), envmap_sphere::default_map()] {
-        let dist = EnvDistribution::new(&map);
-        // Quadrature on a grid 3x finer than the texels, independent of the texel layout.
-        let (w, h) = (map.width() * 3, map.height() * 3);
-        let fine = EnvMap::constant(w, h, Vec3::ZERO);
-        let mut sum = 0.0;
-        for j in 0..h {
-            let sa = fine.texel_solid_angle(j);
-            for i in 0..w {
-                sum += f64::from(dist.dir_pdf(fine.texel_dir(i, j))) * sa;
+        for dist in [EnvDistribution::new(&map), EnvDistribution::for_bilinear(&map)] {
+            // Quadrature on a grid 3x finer than the texels, independent of the texel layout.
+            let (w, h) = (map.width() * 3, map.height() * 3);
+            let fine = EnvMap::constant(w, h, Vec3::ZERO);
+            let mut sum = 0.0;
+            for j in 0..h {
+                let sa = fine.texel_solid_angle(j);
+                for i in 0..w {
+                    sum += f64::from(dist.dir_pdf(fine.texel_dir(i, j))) * sa;
+                }
             }
+            assert!((sum - 1.0).abs() < 1e-4, "{}x{}: {sum}", map.width(), map.height());
         }
-        assert!((sum - 1.0).abs() < 1e-4, "{}x{}: {sum}", map.width(), map.height());
     }
 }
 
@@ -220,4 +221,41 @@ fn summed_area_table_matches_brute_force_sums() {
     let total = sat.sum(0, 0, 32, 16)[0];
     let rgb = SummedAreaTable::rgb_power(&map).sum(0, 0, 32, 16);
     assert!((total - luminance(Vec3::new(rgb[0] as f32, rgb[1] as f32, rgb[2] as f32)) as f64).abs() < 1e-4 * total);
+}
+
+#[test]
+fn bilinear_distribution_bounds_radiance_over_pdf() {
+    let map = envmap_sphere::default_map();
+    let plain = EnvDistribution::new(&map);
+    let safe = EnvDistribution::for_bilinear(&map);
+    // Independently: weight = largest luminance in the 3 x 3 neighbourhood, normalized.
+    let (w, h) = (map.width() as i64, map.height() as i64);
+    let weight = |i: i64, j: i64| {
+        let mut m = 0.0f64;
+        for dj in -1..=1 {
+            for di in -1..=1 {
+                let p = map.pixel((i + di).rem_euclid(w) as u32, (j + dj).clamp(0, h - 1) as u32);
+                m = m.max(f64::from(luminance(p)));
+            }
+        }
+        m
+    };
+    let total: f64 = (0..h).map(|j| (0..w).map(|i| weight(i, j)).sum::<f64>() * map.texel_solid_angle(j as u32)).sum();
+    let mut rng = common::rng(12);
+    let (mut worst_plain, mut worst_safe) = (0.0f64, 0.0f64);
+    for _ in 0..200_000 {
+        let s = safe.sample_dir(Vec2::new(rng.random(), rng.random()));
+        assert_eq!(s.pdf, safe.dir_pdf(s.dir));
+        let (i, j) = map.texel_of_dir(s.dir);
+        let want = (weight(i64::from(i), i64::from(j)) / total) as f32;
+        assert!((s.pdf - want).abs() <= 1e-5 * want, "{} vs {want}", s.pdf);
+        // Directions everywhere (uniform), where BRDF sampling would land.
+        let d = common::random_dir(&mut rng);
+        let y = f64::from(luminance(map.lookup(d)));
+        worst_safe = worst_safe.max(y / f64::from(safe.dir_pdf(d)).max(1e-30));
+        worst_plain = worst_plain.max(y / f64::from(plain.dir_pdf(d)).max(1e-30));
+    }
+    // bilinear Y / pdf never exceeds the normalization of the 3 x 3 weights
+    assert!(worst_safe <= total * (1.0 + 1e-4), "{worst_safe} > {total}");
+    assert!(worst_plain > 10.0 * worst_safe, "the plain distribution has the spikes this one removes");
 }

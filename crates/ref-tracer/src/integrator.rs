@@ -37,10 +37,11 @@ pub struct EnvLight<'a> {
 }
 
 impl<'a> EnvLight<'a> {
-    /// Builds the sampling distribution of `map`.
+    /// Builds the sampling distribution of `map` ([`EnvDistribution::for_bilinear`]: the map is
+    /// evaluated bilinearly).
     #[must_use]
     pub fn new(map: &'a EnvMap) -> Self {
-        Self { map, dist: EnvDistribution::new(map) }
+        Self { map, dist: EnvDistribution::for_bilinear(map) }
     }
 }
 

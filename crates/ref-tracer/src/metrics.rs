@@ -1,6 +1,12 @@
-//! Image error metrics against a reference: RMSE and relative MSE over all pixels and channels.
-//! (FLIP, the perceptual metric, lives with the commands that compare images.)
+//! Image error metrics against a reference: RMSE and relative MSE over all pixels and channels,
+//! and FLIP (Andersson et al. 2020), the perceptual difference, through the `nv-flip` bindings.
+//!
+//! FLIP here is LDR-FLIP: both images go through the same tone mapping first, stated by
+//! [`FlipTonemap::describe`] and printed with every result: the reference's automatic exposure
+//! (log-average luminance to 0.18), the ACES filmic fit, sRGB encoding to 8 bits, and 67 pixels
+//! per degree (a 0.7 m wide 4K monitor seen from 0.7 m, FLIP's default).
 
+use envmap_sphere::Tonemap;
 use glam::{DVec3, Vec3};
 
 /// Mean over pixels and channels of `per_pixel(reference, test)` (summed over channels).
@@ -32,6 +38,49 @@ pub fn relative_mse(reference: &[Vec3], test: &[Vec3]) -> f64 {
     })
 }
 
+/// The tone mapping applied to both images before LDR-FLIP.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FlipTonemap {
+    /// Exposure + ACES + sRGB, with the reference's automatic exposure.
+    pub tonemap: Tonemap,
+}
+
+impl FlipTonemap {
+    /// The tone mapping for comparisons against `reference`.
+    #[must_use]
+    pub fn for_reference(reference: &[Vec3]) -> Self {
+        Self { tonemap: Tonemap::auto(reference) }
+    }
+
+    /// One line stating the tone mapping, printed with FLIP values.
+    #[must_use]
+    pub fn describe(&self) -> String {
+        format!(
+            "LDR-FLIP after exposure {:.4} (reference log-average luminance to 0.18), ACES (Narkowicz), sRGB 8-bit; {} pixels per degree",
+            self.tonemap.exposure,
+            nv_flip::DEFAULT_PIXELS_PER_DEGREE
+        )
+    }
+}
+
+/// Mean FLIP error of `test` against `reference` (both `width` x `height`), in [0, 1].
+///
+/// # Panics
+/// When the images differ in size or do not match `width` x `height`.
+#[must_use]
+pub fn flip(reference: &[Vec3], test: &[Vec3], width: u32, height: u32, tm: &FlipTonemap) -> f64 {
+    assert_eq!(reference.len(), test.len(), "images differ in size");
+    assert_eq!(reference.len(), (width * height) as usize, "size does not match the pixels");
+    let ldr = |img: &[Vec3]| -> Vec<u8> { img.iter().flat_map(|p| tm.tonemap.apply(*p)).collect() };
+    let (a, b) = (ldr(reference), ldr(test));
+    let error = nv_flip::flip(
+        nv_flip::FlipImageRgb8::with_data(width, height, &a),
+        nv_flip::FlipImageRgb8::with_data(width, height, &b),
+        nv_flip::DEFAULT_PIXELS_PER_DEGREE,
+    );
+    f64::from(nv_flip::FlipPool::from_image(&error).mean())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -44,5 +93,18 @@ mod tests {
         assert!((rmse(&a, &b) - 0.5f64.sqrt()).abs() < 1e-12);
         assert!((relative_mse(&a, &b) - 3.0 / 0.01 / 6.0).abs() < 1e-9);
         assert_eq!(rmse(&a, &a), 0.0);
+    }
+
+    #[test]
+    fn flip_is_zero_for_equal_images_and_grows_with_the_difference() {
+        let (w, h) = (32, 24);
+        let img: Vec<Vec3> = (0..w * h).map(|k| Vec3::splat(0.1 + (k % 7) as f32 * 0.1)).collect();
+        let tm = FlipTonemap::for_reference(&img);
+        assert_eq!(flip(&img, &img, w, h, &tm), 0.0);
+        let small: Vec<Vec3> = img.iter().map(|p| *p * 1.1).collect();
+        let large: Vec<Vec3> = img.iter().map(|p| *p * 3.0).collect();
+        let (fs, fl) = (flip(&img, &small, w, h, &tm), flip(&img, &large, w, h, &tm));
+        assert!(fs > 0.0 && fl > 2.0 * fs && fl < 1.0, "{fs} {fl}");
+        assert!(tm.describe().contains("ACES"));
     }
 }

@@ -1,0 +1,180 @@
+//! `cargo xtask render`: the reference tracer on a built-in scene, with a progress bar and one
+//! summary line; and `cargo xtask compare REF TEST`: RMSE and FLIP.
+
+use envmap_sphere::{EnvMap, Sh9, Tonemap};
+use glam::Vec3;
+use ref_tracer::metrics::{FlipTonemap, flip, rmse};
+use ref_tracer::{EnvLight, Integrator, LightSet, RenderSettings, SceneBvh, Strategy};
+use scene::{DistantLight, Scene};
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+/// What `render` was asked for.
+pub struct RenderArgs {
+    pub scene: String,
+    pub envmap: Option<PathBuf>,
+    pub integrator: String,
+    pub lights: Option<PathBuf>,
+    pub shadow_ambient: bool,
+    pub max_depth: u32,
+    pub spp: u32,
+    pub seed: u64,
+    pub time_budget: Option<f64>,
+    pub size: Option<(u32, u32)>,
+    pub out: PathBuf,
+    pub aovs: bool,
+}
+
+/// The map from `--envmap`, or the embedded default.
+pub fn load_map(path: Option<&Path>) -> Result<EnvMap, String> {
+    match path {
+        Some(p) => EnvMap::load(p).map_err(|e| e.to_string()),
+        None => Ok(envmap_sphere::default_map()),
+    }
+}
+
+#[derive(Deserialize)]
+struct LightsFile {
+    lights: Vec<LightEntry>,
+}
+
+#[derive(Deserialize)]
+struct LightEntry {
+    direction: [f32; 3],
+    solid_angle: f32,
+    radiance: [f32; 3],
+}
+
+/// Lights from a `lights.json` (the light-extract schema; only `lights[].direction`,
+/// `solid_angle` and `radiance` are read) and, when an `ambient.exr` sits beside it, its SH9.
+pub fn load_lights(path: &Path) -> Result<(Vec<DistantLight>, Option<Sh9>), String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let file: LightsFile = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut lights = Vec::with_capacity(file.lights.len());
+    for (k, l) in file.lights.iter().enumerate() {
+        let d = Vec3::from_array(l.direction);
+        let r = Vec3::from_array(l.radiance);
+        let ok =
+            d.is_finite() && d.length() > 0.0 && l.solid_angle > 0.0 && l.solid_angle <= 4.0 * std::f32::consts::PI;
+        if !ok || !r.is_finite() || r.min_element() < 0.0 {
+            return Err(format!(
+                "{}: light {k} is invalid (direction must be non-zero, solid_angle in (0, 4 pi], radiance finite and non-negative)",
+                path.display()
+            ));
+        }
+        lights.push(DistantLight { direction: d.normalize(), solid_angle: l.solid_angle, radiance: r });
+    }
+    let ambient_path = path.with_file_name("ambient.exr");
+    let ambient = if ambient_path.exists() {
+        Some(Sh9::project(&EnvMap::load(&ambient_path).map_err(|e| e.to_string())?))
+    } else {
+        None
+    };
+    Ok((lights, ambient))
+}
+
+pub fn run(args: &RenderArgs) -> Result<(), String> {
+    let mut scene = Scene::builtin(&args.scene).map_err(|e| e.to_string())?;
+    if let Some((w, h)) = args.size {
+        if w == 0 || h == 0 || u64::from(w) * u64::from(h) > 1 << 26 {
+            return Err(format!("--size {w}x{h}: each side at least 1 and at most 2^26 pixels in all"));
+        }
+        scene.camera.width = w;
+        scene.camera.height = h;
+    }
+    if args.spp == 0 {
+        return Err("--spp must be at least 1".into());
+    }
+    let map = load_map(args.envmap.as_deref())?;
+    let light_data = match &args.lights {
+        Some(p) => Some(load_lights(p)?),
+        None => None,
+    };
+    let integrator = match args.integrator.as_str() {
+        "env-direct" => Integrator::EnvDirect(Strategy::Mis),
+        "path" => Integrator::Path { max_depth: args.max_depth.max(1) },
+        "lights" => {
+            let (lights, ambient) = light_data.as_ref().ok_or("--integrator lights needs --lights LIGHTS.json")?;
+            Integrator::Lights(LightSet {
+                lights,
+                ambient: *ambient,
+                shadow_ambient: args.shadow_ambient,
+                background: Some(&map),
+            })
+        }
+        other => return Err(format!("unknown integrator {other:?}: env-direct, lights or path")),
+    };
+    let env = EnvLight::new(&map);
+    let bvh = SceneBvh::new(&scene);
+    let bar = indicatif::ProgressBar::new(u64::from(args.spp));
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} spp, {elapsed} (eta {eta})")
+            .map_err(|e| e.to_string())?,
+    );
+    bar.set_message(format!("{} {}", scene.name, args.integrator));
+    let settings =
+        RenderSettings { spp: args.spp, seed: args.seed, time_budget: args.time_budget.map(Duration::from_secs_f64) };
+    let img = ref_tracer::render(&scene, &bvh, Some(&env), &integrator, &settings, &|done, _| {
+        bar.set_position(u64::from(done))
+    });
+    bar.finish_and_clear();
+    write_outputs(&img, args)?;
+    let samples = f64::from(img.width) * f64::from(img.height) * f64::from(img.spp);
+    println!(
+        "{} {} x {}, {} spp, {}, {:.2} s, {:.2} M samples/s -> {}",
+        scene.name,
+        img.width,
+        img.height,
+        img.spp,
+        args.integrator,
+        img.seconds,
+        samples / img.seconds.max(1e-9) / 1e6,
+        args.out.display()
+    );
+    Ok(())
+}
+
+fn write_outputs(img: &ref_tracer::Render, args: &RenderArgs) -> Result<(), String> {
+    let (w, h) = (img.width as usize, img.height as usize);
+    let save = |suffix: &str, px: &[Vec3]| -> Result<(), String> {
+        let path = if suffix.is_empty() { args.out.clone() } else { args.out.with_extension(format!("{suffix}.exr")) };
+        envmap_sphere::io::save_exr_rgb(&path, w, h, px).map_err(|e| e.to_string())
+    };
+    save("", &img.color)?;
+    let png = args.out.with_extension("png");
+    envmap_sphere::io::save_png_rgb(&png, img.width, img.height, &img.color, &Tonemap::auto(&img.color))
+        .map_err(|e| e.to_string())?;
+    if args.aovs {
+        save("albedo", &img.albedo)?;
+        save("normal", &img.normal)?;
+        // background: depth 0 and object id 0; objects are numbered from 1
+        let depth: Vec<Vec3> = img.depth.iter().map(|d| Vec3::splat(if d.is_finite() { *d } else { 0.0 })).collect();
+        save("depth", &depth)?;
+        let ids: Vec<Vec3> =
+            img.object_id.iter().map(|o| Vec3::splat(if *o == u32::MAX { 0.0 } else { (*o + 1) as f32 })).collect();
+        save("object", &ids)?;
+    }
+    Ok(())
+}
+
+/// `compare`: RMSE and FLIP of TEST against REF, one per line.
+pub fn compare(reference: &Path, test: &Path) -> Result<(), String> {
+    let a = envmap_sphere::load_rgb_image(reference).map_err(|e| e.to_string())?;
+    let b = envmap_sphere::load_rgb_image(test).map_err(|e| e.to_string())?;
+    if (a.width, a.height) != (b.width, b.height) {
+        return Err(format!(
+            "{}: {} x {} does not match {} ({} x {})",
+            test.display(),
+            b.width,
+            b.height,
+            reference.display(),
+            a.width,
+            a.height
+        ));
+    }
+    let tm = FlipTonemap::for_reference(&a.pixels);
+    println!("RMSE {:.6}", rmse(&a.pixels, &b.pixels));
+    println!("FLIP {:.6} ({})", flip(&a.pixels, &b.pixels, a.width, a.height, &tm), tm.describe());
+    Ok(())
+}
