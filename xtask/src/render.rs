@@ -113,8 +113,12 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             .map_err(|e| e.to_string())?,
     );
     bar.set_message(format!("{} {}", scene.name, args.integrator));
-    let settings =
-        RenderSettings { spp: args.spp, seed: args.seed, time_budget: args.time_budget.map(Duration::from_secs_f64) };
+    let settings = RenderSettings {
+        spp: args.spp,
+        seed: args.seed,
+        time_budget: args.time_budget.map(Duration::from_secs_f64),
+        aovs: args.aovs,
+    };
     let img = ref_tracer::render(&scene, &bvh, Some(&env), &integrator, &settings, &|done, _| {
         bar.set_position(u64::from(done))
     });

@@ -91,3 +91,82 @@ fn scene_writes_obj_and_refuses_unknown_names() {
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("unknown scene \"teapot\""));
 }
+
+#[test]
+fn render_writes_images_and_compare_reports_rmse_and_flip() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli-render");
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let (a, b) = (dir.join("a.exr"), dir.join("b.exr"));
+    let base = ["render", "--scene", "spheres_box", "--size", "64x48", "--spp", "4"];
+    let out = xtask(&[&base[..], &["--seed", "1", "--aovs", "--out", a.to_str().unwrap_or_default()]].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let line = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(line.trim().lines().count(), 1, "one summary line: {line}");
+    assert!(line.contains("64 x 48, 4 spp") && line.contains("samples/s"), "{line}");
+    for f in ["a.exr", "a.png", "a.albedo.exr", "a.normal.exr", "a.depth.exr", "a.object.exr"] {
+        assert!(dir.join(f).exists(), "{f} missing");
+    }
+    let out = xtask(&[&base[..], &["--seed", "2", "--out", b.to_str().unwrap_or_default()]].concat());
+    assert!(out.status.success());
+    let out = xtask(&["compare", a.to_str().unwrap_or_default(), b.to_str().unwrap_or_default()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let lines: Vec<&str> = text.trim().lines().collect();
+    assert_eq!(lines.len(), 2, "{text}");
+    let value = |line: &str, key: &str| -> f64 {
+        assert!(line.starts_with(key), "{line}");
+        line.split_whitespace().nth(1).and_then(|v| v.parse().ok()).unwrap_or(-1.0)
+    };
+    assert!(value(lines[0], "RMSE") > 0.0);
+    assert!(value(lines[1], "FLIP") > 0.0 && lines[1].contains("ACES"), "the tone mapping is stated");
+    // identical images: zero
+    let out = xtask(&["compare", a.to_str().unwrap_or_default(), a.to_str().unwrap_or_default()]);
+    assert!(String::from_utf8_lossy(&out.stdout).starts_with("RMSE 0.000000\nFLIP 0.000000"));
+    // mismatched sizes and bad files: exit 1, one line
+    let c = dir.join("c.exr");
+    let out = xtask(&[
+        "render",
+        "--scene",
+        "column",
+        "--size",
+        "32x24",
+        "--spp",
+        "1",
+        "--out",
+        c.to_str().unwrap_or_default(),
+    ]);
+    assert!(out.status.success());
+    for (x, y) in [(&a, &c), (&a, &dir.join("missing.exr"))] {
+        let out = xtask(&["compare", x.to_str().unwrap_or_default(), y.to_str().unwrap_or_default()]);
+        assert_eq!(out.status.code(), Some(1));
+        assert_eq!(String::from_utf8_lossy(&out.stderr).trim().lines().count(), 1);
+    }
+}
+
+#[test]
+fn render_with_lights_reads_the_light_extract_schema() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli-lights");
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let json = dir.join("lights.json");
+    std::fs::write(
+        &json,
+        r#"{"method": "hand", "lights": [{"direction": [0.3, 0.8, 0.5], "solid_angle": 0.001, "radiance": [2000, 1900, 1800], "power": [2, 1.9, 1.8], "extent": 0.02}]}"#,
+    )
+    .expect("write json");
+    let out_path = dir.join("l.exr");
+    let args = ["render", "--scene", "spheres_box", "--size", "32x24", "--spp", "2", "--integrator", "lights"];
+    let out = xtask(
+        &[&args[..], &["--lights", json.to_str().unwrap_or_default(), "--out", out_path.to_str().unwrap_or_default()]]
+            .concat(),
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    std::fs::write(&json, r#"{"lights": [{"direction": [0, 0, 0], "solid_angle": 0.1, "radiance": [1, 1, 1]}]}"#)
+        .expect("write");
+    let out = xtask(
+        &[&args[..], &["--lights", json.to_str().unwrap_or_default(), "--out", out_path.to_str().unwrap_or_default()]]
+            .concat(),
+    );
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("lights.json") && err.contains("light 0"), "{err}");
+}

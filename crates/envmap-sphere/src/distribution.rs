@@ -21,6 +21,9 @@ pub struct Distribution1D {
     func: Vec<f64>,
     cdf: Vec<f64>,
     integral: f64,
+    /// guide[g]: the cell that contains u = g / n (the cutpoint method): sampling starts there
+    /// and scans forward, expected O(1) steps, finding the same cell as a binary search.
+    guide: Vec<u32>,
 }
 
 impl Distribution1D {
@@ -47,7 +50,17 @@ impl Distribution1D {
         } else {
             cdf.iter_mut().for_each(|c| *c /= integral);
         }
-        Self { func, cdf, integral }
+        let n_cells = func.len();
+        let mut guide = Vec::with_capacity(n_cells);
+        let mut c = 0usize;
+        for g in 0..n_cells {
+            let u = g as f64 / n;
+            while c + 1 < n_cells && cdf[c + 1] <= u {
+                c += 1;
+            }
+            guide.push(c as u32);
+        }
+        Self { func, cdf, integral, guide }
     }
 
     /// Number of cells.
@@ -78,8 +91,12 @@ impl Distribution1D {
     #[must_use]
     pub fn sample(&self, u: f32) -> (usize, f32) {
         let u = f64::from(u.clamp(0.0, ONE_MINUS_EPSILON));
-        // last k with cdf[k] <= u, skipping zero-probability cells
-        let k = self.cdf.partition_point(|&c| c <= u).saturating_sub(1).min(self.len() - 1);
+        // last k with cdf[k] <= u, skipping zero-probability cells: from the guide, forward
+        let n = self.len();
+        let mut k = self.guide[((u * n as f64) as usize).min(n - 1)] as usize;
+        while k + 1 < n && self.cdf[k + 1] <= u {
+            k += 1;
+        }
         let p = self.cell_probability(k);
         let frac = if p > 0.0 { (u - self.cdf[k]) / p } else { 0.0 };
         (k, (frac as f32).clamp(0.0, ONE_MINUS_EPSILON))
@@ -100,6 +117,9 @@ pub struct DirSample {
     pub dir: Vec3,
     /// Density with respect to solid angle.
     pub pdf: f32,
+    /// Lat-long coordinates of the sample, exact (no round trip through `dir`): evaluate the
+    /// map here with [`EnvMap::lookup_uv`].
+    pub uv: Vec2,
 }
 
 /// Luminance importance sampling of a lat-long map.
@@ -113,6 +133,7 @@ pub struct DirSample {
 /// let map = EnvMap::from_fn(32, 16, |d| Vec3::splat(1.0 + d.y.max(0.0)));
 /// let dist = EnvDistribution::new(&map);
 /// let s = dist.sample_dir(Vec2::new(0.3, 0.7));
+/// assert_eq!(s.pdf, dist.uv_pdf(s.uv));
 /// assert!((s.pdf - dist.dir_pdf(s.dir)).abs() < 1e-5 * s.pdf);
 /// let u = dist.invert_dir_sample(s.dir);
 /// assert!((u - Vec2::new(0.3, 0.7)).length() < 1e-4);
@@ -200,15 +221,29 @@ impl EnvDistribution {
         let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
         let (sp, cp) = phi.sin_cos();
         let dir = Vec3::new(sin_theta * sp, cos_theta, -sin_theta * cp);
-        // The pdf of the texel the f32 direction lies in: a sample drawn within rounding of a
-        // texel edge may land in the neighbour, and MIS needs sample_dir and dir_pdf to agree.
-        DirSample { dir, pdf: self.dir_pdf(dir) }
+        // uv of the same point, kept inside the sampled texel despite rounding
+        let (w, h) = (self.width as f32, self.height as f32);
+        let inside =
+            |x: f32, k: usize, n: f32| x.clamp(k as f32 / n, ((k + 1) as f32 / n).next_down()).min(ONE_MINUS_EPSILON);
+        let theta = sin_theta.atan2(cos_theta);
+        let uv = Vec2::new(inside((i as f32 + s) / w, i, w), inside(theta / std::f32::consts::PI, j, h));
+        // The pdf of the texel the sample was drawn in. `dir_pdf(dir)` agrees except within
+        // f32 rounding of a texel edge, where the direction may round into the neighbour.
+        DirSample { dir, pdf: self.texel_pdf[j * self.width as usize + i], uv }
     }
 
     /// Density with respect to solid angle of sampling `dir` (need not be normalized).
     #[must_use]
     pub fn dir_pdf(&self, dir: Vec3) -> f32 {
-        let (i, j, _, _) = self.locate(dir);
+        self.uv_pdf(crate::latlong::latlong_dir_to_uv(dir.normalize_or(Vec3::Y)))
+    }
+
+    /// [`EnvDistribution::dir_pdf`] of the direction with lat-long coordinates `uv`: lets a
+    /// caller that also looks up radiance convert the direction once.
+    #[must_use]
+    pub fn uv_pdf(&self, uv: Vec2) -> f32 {
+        let i = ((uv.x * self.width as f32) as usize).min(self.width as usize - 1);
+        let j = ((uv.y * self.height as f32) as usize).min(self.height as usize - 1);
         self.texel_pdf[j * self.width as usize + i]
     }
 

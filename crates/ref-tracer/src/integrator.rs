@@ -159,7 +159,7 @@ fn env_direct(
         if ls.pdf > 0.0 && fc != Vec3::ZERO && !bvh.occluded(sh.origin(), ls.dir, f32::INFINITY) {
             let w =
                 if strategy == Strategy::Mis { power_heuristic(ls.pdf, sh.material.brdf_pdf(sh.wo, wi)) } else { 1.0 };
-            l += fc * env.map.lookup(ls.dir) * (w / ls.pdf);
+            l += fc * env.map.lookup_uv(ls.uv) * (w / ls.pdf);
         }
     }
     let mut next = None;
@@ -169,8 +169,9 @@ fn env_direct(
         if fc != Vec3::ZERO {
             next = Some((wi_world, fc / pdf, pdf));
             if strategy != Strategy::EnvOnly && !bvh.occluded(sh.origin(), wi_world, f32::INFINITY) {
-                let w = if strategy == Strategy::Mis { power_heuristic(pdf, env.dist.dir_pdf(wi_world)) } else { 1.0 };
-                l += fc * env.map.lookup(wi_world) * (w / pdf);
+                let uv = envmap_sphere::latlong::latlong_dir_to_uv(wi_world);
+                let w = if strategy == Strategy::Mis { power_heuristic(pdf, env.dist.uv_pdf(uv)) } else { 1.0 };
+                l += fc * env.map.lookup_uv(uv) * (w / pdf);
             }
         }
     }

@@ -20,11 +20,13 @@ pub struct RenderSettings {
     pub seed: u64,
     /// Stop after the first pass that ends past this budget (the image then has fewer spp).
     pub time_budget: Option<Duration>,
+    /// Compute the AOVs (one extra ray per pixel); without, they are left empty.
+    pub aovs: bool,
 }
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        Self { spp: 16, seed: 0, time_budget: None }
+        Self { spp: 16, seed: 0, time_budget: None, aovs: true }
     }
 }
 
@@ -37,7 +39,8 @@ pub struct Render {
     pub height: u32,
     /// Linear RGB radiance, the plain mean of each pixel's samples (box filter).
     pub color: Vec<Vec3>,
-    /// AOV: diffuse albedo of the first hit (zero for the background).
+    /// AOV: diffuse albedo of the first hit (zero for the background). The AOVs are empty when
+    /// [`RenderSettings::aovs`] is off.
     pub albedo: Vec<Vec3>,
     /// AOV: unit shading normal of the first hit, facing the camera (zero for the background).
     pub normal: Vec<Vec3>,
@@ -62,8 +65,8 @@ pub fn render(
     settings: &RenderSettings,
     progress: &(dyn Fn(u32, u32) + Sync),
 ) -> Render {
-    let cam = scene.camera;
-    let (w, h) = (cam.width, cam.height);
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    let cam = scene.camera.rays();
     let n = (w * h) as usize;
     let start = Instant::now();
     let tiles: Vec<(u32, u32)> =
@@ -108,13 +111,20 @@ pub fn render(
         width: w,
         height: h,
         color,
-        albedo: vec![Vec3::ZERO; n],
-        normal: vec![Vec3::ZERO; n],
-        depth: vec![f32::INFINITY; n],
-        object_id: vec![u32::MAX; n],
+        albedo: vec![],
+        normal: vec![],
+        depth: vec![],
+        object_id: vec![],
         spp: done,
         seconds,
     };
+    if !settings.aovs {
+        return r;
+    }
+    r.albedo = vec![Vec3::ZERO; n];
+    r.normal = vec![Vec3::ZERO; n];
+    r.depth = vec![f32::INFINITY; n];
+    r.object_id = vec![u32::MAX; n];
     let aovs: Vec<_> = (0..n)
         .into_par_iter()
         .map(|pixel| {

@@ -2,7 +2,7 @@
 //! is bit-identical for a seed whatever the thread count or tile order.
 
 use glam::Vec2;
-use rand::{Rng, SeedableRng};
+use rand::Rng;
 use rand_pcg::Pcg32;
 
 /// SplitMix64 finalizer: decorrelates consecutive keys.
@@ -24,7 +24,8 @@ impl PixelSampler {
         let key = mix(seed
             ^ mix(pixel.wrapping_add(0x9e37_79b9_7f4a_7c15))
             ^ mix(sample.wrapping_mul(0x2545_f491_4f6c_dd1d)));
-        Self { rng: Pcg32::seed_from_u64(key) }
+        // state and stream straight from the key: cheaper than seed_from_u64's seeding PCG
+        Self { rng: Pcg32::new(key, mix(key ^ 0xda3e_39cb_94b9_5bdb)) }
     }
 
     /// A number in [0, 1).

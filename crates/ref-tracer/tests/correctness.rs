@@ -16,7 +16,14 @@ fn small(name: &str, w: u32, h: u32) -> Scene {
 fn run(scene: &Scene, map: Option<&EnvMap>, integrator: &Integrator, spp: u32, seed: u64) -> Render {
     let bvh = SceneBvh::new(scene);
     let env = map.map(EnvLight::new);
-    render(scene, &bvh, env.as_ref(), integrator, &RenderSettings { spp, seed, time_budget: None }, &|_, _| {})
+    render(
+        scene,
+        &bvh,
+        env.as_ref(),
+        integrator,
+        &RenderSettings { spp, seed, time_budget: None, aovs: true },
+        &|_, _| {},
+    )
 }
 
 /// Mean over the interior pixels of object `object` (see [`interior`]).
@@ -90,14 +97,22 @@ fn mis_pdfs_are_the_pdfs_of_the_samples_drawn() {
     let mut s = ref_tracer::sampler::PixelSampler::new(3, 5, 7);
     let glossy =
         Material { albedo: Vec3::splat(0.5), specular: Some(scene::Ggx { roughness: 0.3, f0: Vec3::splat(0.04) }) };
+    let mut edge = 0;
     for _ in 0..20_000 {
+        // The light sample's pdf is its texel's; looking its uv up again gives the same, and
+        // the direction (rounded to f32) gives the same but within rounding of texel edges.
         let ls = env.dist.sample_dir(s.next_2d());
-        assert_eq!(ls.pdf, env.dist.dir_pdf(ls.dir));
+        assert_eq!(ls.pdf, env.dist.uv_pdf(ls.uv));
+        assert_eq!(env.dist.uv_pdf(envmap_sphere::latlong::latlong_dir_to_uv(ls.dir)), env.dist.dir_pdf(ls.dir));
+        if ls.pdf != env.dist.dir_pdf(ls.dir) {
+            edge += 1;
+        }
         let wo = scene::brdf::sample_cosine_hemisphere(s.next_2d());
         if let Some((wi, pdf)) = glossy.sample_brdf(wo, s.next_2d(), s.next_1d()) {
             assert!((pdf - glossy.brdf_pdf(wo, wi)).abs() <= 1e-6 * pdf);
         }
     }
+    assert!(edge < 20, "{edge} of 20000 light samples round across a texel edge");
 }
 
 /// Mean of the whole image over `seeds` independent renders, and its standard error.

@@ -30,19 +30,49 @@ impl Camera {
     }
 
     /// Ray through image position (x, y) in pixels from the top-left corner (pixel centres at
-    /// half-integers): (origin, unit direction).
+    /// half-integers): (origin, unit direction). For many rays, [`Camera::rays`] precomputes.
     #[must_use]
     pub fn ray(&self, x: f32, y: f32) -> (Vec3, Vec3) {
+        self.rays().ray(x, y)
+    }
+
+    /// The camera's basis and scales, precomputed for generating many rays.
+    #[must_use]
+    pub fn rays(&self) -> CameraRays {
         let (right, up, forward) = self.basis();
         let tan_half = (self.hfov_degrees.to_radians() * 0.5).tan();
-        let sx = (2.0 * x / self.width as f32 - 1.0) * tan_half;
-        let sy = (1.0 - 2.0 * y / self.height as f32) * tan_half * self.height as f32 / self.width as f32;
-        (self.eye, (forward + right * sx + up * sy).normalize())
+        let (w, h) = (self.width as f32, self.height as f32);
+        CameraRays {
+            eye: self.eye,
+            right: right * (2.0 * tan_half / w),
+            down: up * (-2.0 * tan_half / w),
+            corner: forward - right * tan_half + up * (tan_half * h / w),
+        }
     }
 
     /// Angle subtended by one pixel at the image centre, radians.
     #[must_use]
     pub fn pixel_angle(&self) -> f32 {
         2.0 * (self.hfov_degrees.to_radians() * 0.5).tan() / self.width as f32
+    }
+}
+
+/// Precomputed ray generation of a [`Camera`].
+#[derive(Clone, Copy, Debug)]
+pub struct CameraRays {
+    eye: Vec3,
+    /// image-plane step per pixel to the right
+    right: Vec3,
+    /// image-plane step per pixel down
+    down: Vec3,
+    /// image-plane point of pixel coordinate (0, 0), the top-left corner
+    corner: Vec3,
+}
+
+impl CameraRays {
+    /// As [`Camera::ray`].
+    #[must_use]
+    pub fn ray(&self, x: f32, y: f32) -> (Vec3, Vec3) {
+        (self.eye, (self.corner + self.right * x + self.down * y).normalize())
     }
 }

@@ -18,7 +18,7 @@ mod mesh;
 mod obj;
 
 pub use builtin::BUILTIN_SCENES;
-pub use camera::Camera;
+pub use camera::{Camera, CameraRays};
 pub use light::DistantLight;
 pub use material::{Ggx, Material};
 pub use mesh::Mesh;
