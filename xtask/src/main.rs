@@ -3,6 +3,7 @@
 
 #![allow(clippy::print_stdout, clippy::print_stderr)]
 
+mod extract;
 mod info;
 mod lavapipe;
 mod render;
@@ -84,6 +85,24 @@ enum Command {
         #[arg(long)]
         aovs: bool,
     },
+    /// Decompose a map into shadow-casting lights + ambient: DIR/lights.json, ambient.exr,
+    /// lights.gltf (KHR_lights_punctual) and overlay.png.
+    Extract {
+        /// The map (.exr or .hdr).
+        path: PathBuf,
+        /// median-cut or importance.
+        #[arg(long, default_value = "median-cut")]
+        method: String,
+        /// Number of lights K (median cut uses the largest power of two not above K).
+        #[arg(long, default_value_t = 32)]
+        lights: usize,
+        /// Output folder; target/extract/<map>-<method> when absent.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// glTF intensity per unit of the map's luminance x sr (683 for maps in W/(m^2 sr)).
+        #[arg(long, default_value_t = 1.0)]
+        lux_per_unit: f32,
+    },
     /// RMSE and FLIP of TEST against REF (two lines).
     Compare {
         /// Reference image (.exr or .hdr).
@@ -141,6 +160,9 @@ fn main() -> ExitCode {
             aovs,
         }),
         Command::Compare { reference, test } => render::compare(&reference, &test),
+        Command::Extract { path, method, lights, out, lux_per_unit } => {
+            extract::run(&path, &method, lights, out.as_deref(), lux_per_unit)
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -170,3 +170,47 @@ fn render_with_lights_reads_the_light_extract_schema() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("lights.json") && err.contains("light 0"), "{err}");
 }
+
+#[test]
+fn extract_writes_the_four_files_and_a_line_per_light() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli-extract");
+    let _ = std::fs::remove_dir_all(&dir);
+    let map = shared("venice_sunset_1k.hdr");
+    let out = xtask(&[
+        "extract",
+        map.to_str().unwrap_or_default(),
+        "--lights",
+        "16",
+        "--out",
+        dir.to_str().unwrap_or_default(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(text.lines().filter(|l| l.starts_with("light ")).count(), 16, "{text}");
+    assert!(text.contains("median-cut: 16 lights in") && text.contains("light power / map power = 1.0000"), "{text}");
+    for f in ["lights.json", "ambient.exr", "lights.gltf", "overlay.png"] {
+        assert!(dir.join(f).exists(), "{f} missing");
+    }
+    // the lights feed the reference tracer's lights integrator
+    let img = dir.join("r.exr");
+    let json = dir.join("lights.json");
+    let out = xtask(&[
+        "render",
+        "--scene",
+        "spheres_box",
+        "--size",
+        "32x24",
+        "--spp",
+        "2",
+        "--integrator",
+        "lights",
+        "--lights",
+        json.to_str().unwrap_or_default(),
+        "--out",
+        img.to_str().unwrap_or_default(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = xtask(&["extract", map.to_str().unwrap_or_default(), "--method", "nope"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("median-cut, importance"));
+}

@@ -215,7 +215,15 @@ pub fn save_png_rgb(
     tonemap: &Tonemap,
 ) -> Result<(), EnvMapError> {
     let bytes: Vec<u8> = pixels.iter().flat_map(|p| tonemap.apply(*p)).collect();
-    image::save_buffer_with_format(path, &bytes, width, height, image::ExtendedColorType::Rgb8, image::ImageFormat::Png)
+    save_png_srgb8(path, width, height, &bytes)
+}
+
+/// Writes row-major 8-bit sRGB triples as a PNG.
+///
+/// # Errors
+/// [`EnvMapError::Encode`] when the file cannot be written or the buffer does not match the size.
+pub fn save_png_srgb8(path: &Path, width: u32, height: u32, bytes: &[u8]) -> Result<(), EnvMapError> {
+    image::save_buffer_with_format(path, bytes, width, height, image::ExtendedColorType::Rgb8, image::ImageFormat::Png)
         .map_err(|e| EnvMapError::Encode { path: path.to_path_buf(), format: "PNG", reason: e.to_string() })
 }
 

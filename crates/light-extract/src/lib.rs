@@ -1,6 +1,35 @@
 //! Decomposes an HDR environment map into a few shadow-casting distant area lights (cones) plus
-//! an ambient remainder: centre-surround extraction (paper 000), the emissive split with
-//! EnvDirects / EnvIndirects (paper 001), and the median-cut, variance-minimization and
-//! importance-sampling baselines.
+//! an ambient remainder, and keeps the books: for methods that partition the map's pixels, light
+//! power + remainder power = map power.
 //!
-//! Architecture invariant: knows lights, never wgpu. Filled by the `light-extract` issue.
+//! Methods, each a type implementing [`LightExtractor`] with its parameters as fields:
+//! - [`MedianCut`] (Debevec 2005): 2^n regions of equal energy, a light at each energy centroid.
+//! - [`ImportanceSampled`]: K samples of the map's luminance distribution as equal-power
+//!   lights (a baseline).
+//!
+//! Centre-surround extraction (paper 000), the emissive split with EnvDirects / EnvIndirects
+//! (paper 001) and variance minimization (Viriyothai and Debevec 2009) are the next methods.
+//!
+//! Outputs: [`Decomposition::to_json`] (`lights.json`), [`Decomposition::to_gltf`] (glTF 2.0 with
+//! `KHR_lights_punctual` directional lights), the remainder map (`ambient.exr`) and an overlay of
+//! the lights on the map ([`overlay`]).
+//!
+//! ```
+//! use light_extract::{LightExtractor, MedianCut};
+//! let map = envmap_sphere::default_map();
+//! let d = MedianCut { depth: 3 }.extract(&map).unwrap();
+//! assert_eq!(d.lights.len(), 8);
+//! assert!(d.power_balance_error() < 1e-4);
+//! ```
+//!
+//! Architecture invariant: knows lights, never wgpu.
+
+mod decomposition;
+mod importance;
+mod median_cut;
+pub mod output;
+pub mod overlay;
+
+pub use decomposition::{Decomposition, ExtractError, ExtractedLight, LightExtractor, interleaved_sets};
+pub use importance::ImportanceSampled;
+pub use median_cut::MedianCut;

@@ -1,0 +1,101 @@
+//! Files a decomposition is written as: `lights.json`, `ambient.exr` and `lights.gltf`.
+//!
+//! `lights.json` (units: radiance in the map's units, W/(m^2 sr) for a calibrated map; solid
+//! angles in steradians; angles in radians; directions are unit vectors towards the light in
+//! the toolkit's world, right-handed, +Y up):
+//!
+//! ```text
+//! { "method": "median-cut", "params": {...}, "time_ms": 1.2,
+//!   "map_power": [r, g, b],          // integral of the map's radiance over the sphere
+//!   "ambient_power": [r, g, b],      // the same for the remainder (ambient.exr)
+//!   "lights": [ { "direction": [x, y, z], "solid_angle": sr, "half_angle": rad,
+//!                 "radiance": [r, g, b], "power": [r, g, b], "extent": rad }, ... ],
+//!   "interleaved": [ [ light, ... ], ... ] }   // the extra sets of interleaved sampling
+//! ```
+//!
+//! `power` is radiance x solid angle: the irradiance the light gives a surface facing it. In
+//! `lights.gltf` each light is a `KHR_lights_punctual` directional light whose node's -Z axis
+//! points the way the light travels (away from `direction`); `intensity` is the luminance
+//! 0.2126 R + 0.7152 G + 0.0722 B of `power` times `lux_per_unit` (683 lm/W for a map calibrated
+//! in W/(m^2 sr); 1 keeps the map's own units), and `color` is `power` divided by its largest
+//! component.
+
+use crate::decomposition::{Decomposition, ExtractedLight};
+use glam::{Quat, Vec3};
+use serde_json::{Value, json};
+use std::path::Path;
+
+fn light_json(l: &ExtractedLight) -> Value {
+    let p = l.power();
+    json!({
+        "direction": l.light.direction.to_array(),
+        "solid_angle": l.light.solid_angle,
+        "half_angle": l.light.half_angle(),
+        "radiance": l.light.radiance.to_array(),
+        "power": p.to_array(),
+        "extent": l.extent,
+    })
+}
+
+impl Decomposition {
+    /// The `lights.json` document; `interleaved` are the extra sets (without the first).
+    #[must_use]
+    pub fn to_json(&self, interleaved: &[Vec<ExtractedLight>]) -> Value {
+        json!({
+            "method": self.method,
+            "params": self.params,
+            "time_ms": self.time_ms,
+            "map_power": self.map_power,
+            "ambient_power": self.ambient.power(),
+            "lights": self.lights.iter().map(light_json).collect::<Vec<_>>(),
+            "interleaved": interleaved.iter().map(|set| set.iter().map(light_json).collect::<Vec<_>>()).collect::<Vec<_>>(),
+        })
+    }
+
+    /// A glTF 2.0 document with one `KHR_lights_punctual` directional light per light.
+    #[must_use]
+    pub fn to_gltf(&self, lux_per_unit: f32) -> Value {
+        let mut lights = Vec::new();
+        let mut nodes = Vec::new();
+        for (k, l) in self.lights.iter().enumerate() {
+            let p = l.power();
+            let max = p.max_element().max(f32::MIN_POSITIVE);
+            lights.push(json!({
+                "type": "directional",
+                "name": format!("{}-{k}", self.method),
+                "color": (p / max).to_array(),
+                "intensity": envmap_sphere::luminance(p) * lux_per_unit,
+            }));
+            let rotation = Quat::from_rotation_arc(Vec3::NEG_Z, -l.light.direction.normalize());
+            nodes.push(json!({
+                "name": format!("light-{k}"),
+                "rotation": rotation.to_array(),
+                "extensions": { "KHR_lights_punctual": { "light": k } },
+            }));
+        }
+        json!({
+            "asset": { "version": "2.0", "generator": "envshadow light-extract" },
+            "extensionsUsed": ["KHR_lights_punctual"],
+            "extensions": { "KHR_lights_punctual": { "lights": lights } },
+            "nodes": nodes,
+            "scenes": [{ "nodes": (0..self.lights.len()).collect::<Vec<_>>() }],
+            "scene": 0,
+        })
+    }
+
+    /// Writes `lights.json`, `ambient.exr` and `lights.gltf` into `dir` (created if missing).
+    ///
+    /// # Errors
+    /// A message naming the file that could not be written.
+    pub fn write(&self, dir: &Path, interleaved: &[Vec<ExtractedLight>], lux_per_unit: f32) -> Result<(), String> {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        let write_json = |name: &str, v: &Value| -> Result<(), String> {
+            let path = dir.join(name);
+            let text = serde_json::to_string_pretty(v).map_err(|e| format!("{}: {e}", path.display()))?;
+            std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))
+        };
+        write_json("lights.json", &self.to_json(interleaved))?;
+        write_json("lights.gltf", &self.to_gltf(lux_per_unit))?;
+        self.ambient.save_exr(dir.join("ambient.exr")).map_err(|e| e.to_string())
+    }
+}

@@ -1,0 +1,255 @@
+//! MedianCut and ImportanceSampled: the power books on real maps, the extremes the issue lists,
+//! interleaved sets, and the files they are written as.
+
+use envmap_sphere::{EnvMap, luminance};
+use glam::Vec3;
+use light_extract::{Decomposition, ImportanceSampled, LightExtractor, MedianCut, interleaved_sets};
+use std::f64::consts::PI;
+use std::path::PathBuf;
+
+fn shared_maps() -> Vec<PathBuf> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/envmaps");
+    let mut maps: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "exr" || x == "hdr"))
+        .collect();
+    maps.sort();
+    assert!(maps.len() >= 11);
+    maps
+}
+
+fn methods(k: usize) -> Vec<Box<dyn LightExtractor>> {
+    vec![Box::new(MedianCut::with_lights(k)), Box::new(ImportanceSampled { count: k, seed: 1 })]
+}
+
+fn no_nan(d: &Decomposition) {
+    for l in &d.lights {
+        assert!(l.light.direction.is_finite() && (l.light.direction.length() - 1.0).abs() < 1e-4, "{l:?}");
+        assert!(l.light.radiance.is_finite() && l.light.solid_angle.is_finite() && l.extent.is_finite(), "{l:?}");
+        assert!(l.light.solid_angle > 0.0 && l.power().min_element() >= 0.0, "{l:?}");
+    }
+    assert!(d.ambient.pixels().iter().all(|p| p.is_finite()));
+}
+
+#[test]
+fn median_cut_partitions_every_shared_map() {
+    for path in shared_maps() {
+        let map = EnvMap::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        let d = MedianCut::default().extract(&map).unwrap_or_else(|e| panic!("{e}"));
+        no_nan(&d);
+        assert!(d.lights.len() <= 32 && d.lights.len() >= 16, "{}: {}", path.display(), d.lights.len());
+        assert!(d.power_balance_error() < 1e-4, "{}: {}", path.display(), d.power_balance_error());
+        let sa: f64 = d.lights.iter().map(|l| f64::from(l.light.solid_angle)).sum();
+        assert!((sa / (4.0 * PI) - 1.0).abs() < 1e-4, "regions tile the sphere: {sa}");
+    }
+}
+
+#[test]
+fn importance_sampling_keeps_luminous_power() {
+    for path in shared_maps().into_iter().take(4) {
+        let map = EnvMap::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        let d = ImportanceSampled::default().extract(&map).unwrap_or_else(|e| panic!("{e}"));
+        no_nan(&d);
+        assert_eq!(d.lights.len(), 32);
+        let y = |p: [f64; 3]| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+        let (lights, total) = (y(d.light_power()), y(d.map_power));
+        assert!((lights / total - 1.0).abs() < 1e-4, "{}: {lights} vs {total}", path.display());
+        // each light carries 1/K of it
+        for l in &d.lights {
+            assert!((f64::from(luminance(l.power())) * 32.0 / total - 1.0).abs() < 1e-3);
+        }
+    }
+}
+
+#[test]
+fn a_black_map_gives_no_lights_and_zero_ambient() {
+    let black = EnvMap::constant(64, 32, Vec3::ZERO);
+    for m in methods(32) {
+        let d = m.extract(&black).unwrap_or_else(|e| panic!("{e}"));
+        assert!(d.lights.is_empty(), "{}", d.method);
+        assert_eq!(d.ambient.power(), [0.0; 3]);
+        assert!(d.ambient_sh.coeffs.iter().all(|c| *c == Vec3::ZERO));
+        assert_eq!(d.power_balance_error(), 0.0);
+    }
+}
+
+#[test]
+fn a_constant_map_is_cut_into_equal_parts() {
+    let l = Vec3::new(1.0, 2.0, 0.5);
+    let map = EnvMap::constant(256, 128, l);
+    let d = MedianCut::default().extract(&map).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(d.lights.len(), 32);
+    let each = 4.0 * PI * f64::from(luminance(l)) / 32.0;
+    for light in &d.lights {
+        assert!((f64::from(luminance(light.power())) / each - 1.0).abs() < 0.1, "{light:?}");
+        assert!((light.light.radiance - l).abs().max_element() < 1e-4, "mean radiance is the constant");
+    }
+    let mean: Vec3 = d.lights.iter().map(|x| x.light.direction).sum::<Vec3>() / 32.0;
+    assert!(mean.length() < 0.05, "lights spread over the sphere: {mean}");
+}
+
+/// One texel at `value` over `floor` elsewhere.
+fn sun_map(w: u32, h: u32, i: u32, j: u32, value: f32, floor: f32) -> EnvMap {
+    let mut map = EnvMap::constant(w, h, Vec3::splat(floor));
+    map.set_pixel(i, j, Vec3::splat(value));
+    map
+}
+
+#[test]
+fn a_half_float_max_sun_is_found_without_overflow() {
+    let map = sun_map(1024, 512, 300, 100, 65504.0, 1e-4);
+    let sun_dir = map.texel_dir(300, 100);
+    let sun_power = 65504.0 * map.texel_solid_angle(100);
+    for m in methods(32) {
+        let d = m.extract(&map).unwrap_or_else(|e| panic!("{e}"));
+        no_nan(&d);
+        let brightest =
+            d.lights.iter().max_by(|a, b| luminance(a.power()).total_cmp(&luminance(b.power()))).expect("a light");
+        let texel = std::f32::consts::PI / 512.0;
+        let held: f64 = d
+            .lights
+            .iter()
+            .filter(|l| l.light.direction.angle_between(sun_dir) < texel)
+            .map(|l| f64::from(l.power().x))
+            .sum();
+        assert!(brightest.light.direction.angle_between(sun_dir) < texel, "{}: {brightest:?}", d.method);
+        assert!(held / sun_power > 0.99, "{}: lights at the sun hold {held} of {sun_power}", d.method);
+    }
+}
+
+#[test]
+fn a_sun_on_the_pole_gives_no_nan() {
+    let map = sun_map(256, 128, 17, 0, 5000.0, 0.01);
+    for m in methods(16) {
+        let d = m.extract(&map).unwrap_or_else(|e| panic!("{e}"));
+        no_nan(&d);
+        // (importance-sampled lights all carry equal power: look for one at the pole)
+        assert!(d.lights.iter().any(|l| l.light.direction.y > 0.999), "{}: no light at the pole", d.method);
+    }
+}
+
+#[test]
+fn one_light_and_a_thousand_lights() {
+    let map = envmap_sphere::default_map();
+    let one = MedianCut::with_lights(1).extract(&map).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(one.lights.len(), 1);
+    assert!(
+        (f64::from(one.lights[0].light.solid_angle) / (4.0 * PI) - 1.0).abs() < 1e-4,
+        "one light covers the sphere"
+    );
+    assert!(one.power_balance_error() < 1e-4);
+    // city.exr's sun holds so much of the energy that median cut cuts it down to single
+    // texels, which cannot split further: fewer than 1024 regions. A smooth map gives all.
+    let many = MedianCut::with_lights(1024).extract(&map).unwrap_or_else(|e| panic!("{e}"));
+    assert!(many.lights.len() > 800 && many.lights.len() <= 1024, "{}", many.lights.len());
+    let smooth = EnvMap::from_fn(1024, 512, |d| Vec3::splat(1.0 + d.y.max(0.0)));
+    assert_eq!(MedianCut::with_lights(1024).extract(&smooth).map(|d| d.lights.len()).unwrap_or(0), 1024);
+    assert!(many.power_balance_error() < 1e-4);
+    no_nan(&many);
+    for k in [1, 1024] {
+        let d = ImportanceSampled { count: k, seed: 0 }.extract(&map).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(d.lights.len(), k);
+        no_nan(&d);
+    }
+    assert_eq!(MedianCut::with_lights(33).depth, 5, "the largest power of two not above K");
+}
+
+#[test]
+fn tiny_and_huge_maps() {
+    let tiny = EnvMap::from_texels(8, 4, |i, j| Vec3::splat(1.0 + (i * 4 + j) as f32));
+    let d = MedianCut { depth: 10 }.extract(&tiny).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(d.lights.len(), 32, "splitting stops at single texels");
+    assert!(d.power_balance_error() < 1e-5);
+    // 8192 x 4096: the map is 384 MiB of f32 RGB; median cut adds a summed-area table of
+    // (W + 1)(H + 1) f64 = 256 MiB and no per-texel state of its own.
+    let huge = sun_map(8192, 4096, 5000, 1000, 30000.0, 0.5);
+    let d = MedianCut::default().extract(&huge).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(d.lights.len(), 32);
+    assert!(d.power_balance_error() < 1e-4);
+}
+
+#[test]
+fn extraction_is_deterministic() {
+    let map = envmap_sphere::default_map();
+    for m in methods(32) {
+        let (a, b) =
+            (m.extract(&map).unwrap_or_else(|e| panic!("{e}")), m.extract(&map).unwrap_or_else(|e| panic!("{e}")));
+        assert_eq!(a.lights, b.lights, "{}", a.method);
+    }
+    let a = ImportanceSampled { count: 32, seed: 1 }.extract(&map).unwrap_or_else(|e| panic!("{e}"));
+    let b = ImportanceSampled { count: 32, seed: 2 }.extract(&map).unwrap_or_else(|e| panic!("{e}"));
+    assert_ne!(a.lights, b.lights, "the seed matters");
+}
+
+#[test]
+fn interleaved_sets_perturb_within_a_tenth_of_the_extent() {
+    let map = envmap_sphere::default_map();
+    let d = MedianCut::default().extract(&map).unwrap_or_else(|e| panic!("{e}"));
+    let sets = interleaved_sets(&d.lights, 8, 0.1, 7);
+    assert_eq!(sets.len(), 8);
+    assert_eq!(sets[0], d.lights);
+    for set in &sets[1..] {
+        for (a, b) in set.iter().zip(&d.lights) {
+            // chord formula: acos loses ~3e-4 rad for nearly parallel f32 vectors
+            let angle = 2.0 * ((a.light.direction - b.light.direction).length() * 0.5).asin();
+            assert!(angle <= 0.1 * b.extent * (1.0 + 1e-3) + 1e-6, "{angle} > 0.1 x {}", b.extent);
+            assert_eq!((a.light.radiance, a.light.solid_angle), (b.light.radiance, b.light.solid_angle));
+        }
+        assert_ne!(set, &d.lights);
+    }
+    assert_eq!(sets, interleaved_sets(&d.lights, 8, 0.1, 7), "fixed seed");
+}
+
+#[test]
+fn files_follow_the_documented_schema() {
+    let map = envmap_sphere::default_map();
+    let d = MedianCut::default().extract(&map).unwrap_or_else(|e| panic!("{e}"));
+    let sets = interleaved_sets(&d.lights, 8, 0.1, 0);
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("extract-files");
+    let _ = std::fs::remove_dir_all(&dir);
+    d.write(&dir, &sets[1..], 1.0).unwrap_or_else(|e| panic!("{e}"));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("lights.json")).unwrap_or_default()).expect("JSON");
+    for key in ["method", "params", "time_ms", "map_power", "ambient_power", "lights", "interleaved"] {
+        assert!(json.get(key).is_some(), "missing {key}");
+    }
+    let lights = json["lights"].as_array().expect("lights");
+    assert_eq!(lights.len(), d.lights.len());
+    for key in ["direction", "solid_angle", "radiance", "power", "extent"] {
+        assert!(lights[0].get(key).is_some(), "light misses {key}");
+    }
+    assert_eq!(json["interleaved"].as_array().map(Vec::len), Some(7));
+    let ambient = EnvMap::load(dir.join("ambient.exr")).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(ambient.power(), [0.0; 3], "median cut leaves no remainder");
+    let gltf: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("lights.gltf")).unwrap_or_default()).expect("glTF");
+    assert_eq!(gltf["asset"]["version"], "2.0");
+    let gl = gltf["extensions"]["KHR_lights_punctual"]["lights"].as_array().expect("lights");
+    assert_eq!(gl.len(), d.lights.len());
+    for (k, l) in d.lights.iter().enumerate() {
+        assert_eq!(gl[k]["type"], "directional");
+        let intensity = gl[k]["intensity"].as_f64().unwrap_or(-1.0);
+        assert!((intensity - f64::from(luminance(l.power()))).abs() <= 1e-3 * intensity.max(1e-6));
+        // the node's -Z axis is the direction light travels: away from `direction`
+        let q = &gltf["nodes"][k]["rotation"];
+        let q = glam::Quat::from_xyzw(
+            q[0].as_f64().unwrap_or(0.0) as f32,
+            q[1].as_f64().unwrap_or(0.0) as f32,
+            q[2].as_f64().unwrap_or(0.0) as f32,
+            q[3].as_f64().unwrap_or(1.0) as f32,
+        );
+        assert!((q * Vec3::NEG_Z + l.light.direction).length() < 1e-4);
+    }
+    let overlay = dir.join("overlay.png");
+    light_extract::overlay::write_overlay(&overlay, &map, &d.lights).unwrap_or_else(|e| panic!("{e}"));
+    assert!(std::fs::read(&overlay).unwrap_or_default().starts_with(b"\x89PNG"));
+}
+
+#[test]
+fn bad_parameters_are_errors() {
+    let map = EnvMap::constant(8, 4, Vec3::ONE);
+    assert!(MedianCut { depth: 25 }.extract(&map).is_err());
+    assert!(ImportanceSampled { count: 0, seed: 0 }.extract(&map).is_err());
+}
