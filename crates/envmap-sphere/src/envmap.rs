@@ -67,7 +67,8 @@ impl EnvMap {
     /// When a side is zero.
     #[must_use]
     pub fn constant(width: u32, height: u32, radiance: Vec3) -> Self {
-        Self::from_texels(width, height, |_, _| radiance)
+        assert!(width > 0 && height > 0, "an EnvMap needs a non-zero size");
+        Self { width, height, pixels: vec![radiance; width as usize * height as usize] }
     }
 
     /// Width W in texels.

@@ -78,6 +78,34 @@ pub fn latlong_texel_vector(i: u32, j: u32, width: u32, height: u32) -> [f64; 3]
     [sin2_theta * (p0.cos() - p1.cos()), cos_sin_theta * (p1 - p0), -sin2_theta * (p1.sin() - p0.sin())]
 }
 
+/// Texel-centre directions of a `width` x `height` map without per-texel trigonometry: the
+/// direction is separable into a row part (sin theta, cos theta) and a column part
+/// (sin phi, cos phi).
+#[derive(Clone, Debug)]
+pub struct TexelDirections {
+    rows: Vec<(f32, f32)>,
+    cols: Vec<(f32, f32)>,
+}
+
+impl TexelDirections {
+    /// Tables for a `width` x `height` map.
+    #[must_use]
+    pub fn new(width: u32, height: u32) -> Self {
+        let rows = (0..height).map(|j| (PI * (j as f32 + 0.5) / height as f32).sin_cos()).collect();
+        let cols = (0..width).map(|i| (TAU * (i as f32 + 0.5) / width as f32).sin_cos()).collect();
+        Self { rows, cols }
+    }
+
+    /// Direction of the centre of texel (i, j); equals `latlong_uv_to_dir` at the centre.
+    #[inline]
+    #[must_use]
+    pub fn dir(&self, i: u32, j: u32) -> Vec3 {
+        let (st, ct) = self.rows[j as usize];
+        let (sp, cp) = self.cols[i as usize];
+        Vec3::new(st * sp, ct, -st * cp)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -91,6 +119,15 @@ mod tests {
         assert!(close(latlong_uv_to_dir(Vec2::new(0.75, 0.5)), Vec3::NEG_X));
         assert!(close(latlong_uv_to_dir(Vec2::new(0.3, 0.0)), Vec3::Y));
         assert!(close(latlong_uv_to_dir(Vec2::new(0.3, 1.0)), Vec3::NEG_Y));
+    }
+
+    #[test]
+    fn texel_direction_tables_match_the_formula() {
+        let t = TexelDirections::new(64, 32);
+        for (i, j) in [(0, 0), (63, 31), (17, 9), (32, 16)] {
+            let d = latlong_uv_to_dir(Vec2::new((i as f32 + 0.5) / 64.0, (j as f32 + 0.5) / 32.0));
+            assert!((t.dir(i, j) - d).length() < 1e-6);
+        }
     }
 
     #[test]

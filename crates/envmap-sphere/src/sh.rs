@@ -44,10 +44,17 @@ impl Sh9 {
     #[must_use]
     pub fn project(map: &EnvMap) -> Self {
         let mut acc = [DVec3::ZERO; 9];
+        if map.pixels().iter().all(|p| *p == Vec3::ZERO) {
+            return Self::default();
+        }
+        let dirs = crate::latlong::TexelDirections::new(map.width(), map.height());
         for j in 0..map.height() {
             let sa = map.texel_solid_angle(j);
             for (i, l) in map.row(j).iter().enumerate() {
-                let basis = sh9_basis(map.texel_dir(i as u32, j));
+                if *l == Vec3::ZERO {
+                    continue;
+                }
+                let basis = sh9_basis(dirs.dir(i as u32, j));
                 let l = l.as_dvec3() * sa;
                 for (a, b) in acc.iter_mut().zip(basis) {
                     *a += l * f64::from(b);

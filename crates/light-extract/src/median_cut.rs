@@ -8,7 +8,7 @@
 //! remainder is zero and light power = map power.
 
 use crate::decomposition::{Decomposition, ExtractError, ExtractedLight, LightExtractor};
-use envmap_sphere::latlong::latlong_uv_to_dir;
+use envmap_sphere::latlong::{TexelDirections, latlong_uv_to_dir};
 use envmap_sphere::{EnvMap, SummedAreaTable, luminance};
 use glam::{DVec3, Vec2, Vec3};
 use scene::DistantLight;
@@ -84,16 +84,18 @@ fn split(sat: &SummedAreaTable<1>, r: Region, w: u32, h: u32) -> Option<(Region,
 }
 
 /// The light standing for region `r`: energy centroid, region solid angle, mean radiance.
-fn region_light(map: &EnvMap, row_sa: &[f64], r: &Region) -> ExtractedLight {
+fn region_light(map: &EnvMap, row_sa: &[f64], dirs: &TexelDirections, r: &Region) -> ExtractedLight {
     let (mut centroid, mut power, mut solid_angle) = (DVec3::ZERO, DVec3::ZERO, 0.0);
     for j in r.y0..r.y1 {
         let sa = row_sa[j as usize];
         solid_angle += sa * f64::from(r.x1 - r.x0);
-        for i in r.x0..r.x1 {
-            let l = map.pixel(i, j);
-            power += l.as_dvec3() * sa;
-            centroid += map.texel_dir(i, j).as_dvec3() * (f64::from(luminance(l).max(0.0)) * sa);
+        let (mut row_power, mut row_centroid) = (Vec3::ZERO, Vec3::ZERO);
+        for (i, l) in (r.x0..r.x1).zip(&map.row(j)[r.x0 as usize..r.x1 as usize]) {
+            row_power += *l;
+            row_centroid += dirs.dir(i, j) * luminance(*l).max(0.0);
         }
+        power += row_power.as_dvec3() * sa;
+        centroid += row_centroid.as_dvec3() * sa;
     }
     let (w, h) = (map.width() as f32, map.height() as f32);
     let uv = |x: u32, y: u32| Vec2::new(x as f32 / w, y as f32 / h);
@@ -135,8 +137,12 @@ impl LightExtractor for MedianCut {
             regions = next;
         }
         let row_sa = map.row_solid_angles();
-        let lights: Vec<ExtractedLight> =
-            regions.iter().map(|r| region_light(map, &row_sa, r)).filter(|l| l.power().max_element() > 0.0).collect();
+        let dirs = TexelDirections::new(w, h);
+        let lights: Vec<ExtractedLight> = regions
+            .iter()
+            .map(|r| region_light(map, &row_sa, &dirs, r))
+            .filter(|l| l.power().max_element() > 0.0)
+            .collect();
         let ambient = EnvMap::constant(w, h, Vec3::ZERO);
         let params = serde_json::json!({ "depth": self.depth });
         let mut d = Decomposition::new("median-cut", params, map, lights, ambient, true);
