@@ -212,5 +212,5 @@ fn extract_writes_the_four_files_and_a_line_per_light() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let out = xtask(&["extract", map.to_str().unwrap_or_default(), "--method", "nope"]);
     assert_eq!(out.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("median-cut, importance"));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("median-cut, variance-min, importance"));
 }

@@ -4,11 +4,13 @@
 //!
 //! Methods, each a type implementing [`LightExtractor`] with its parameters as fields:
 //! - [`MedianCut`] (Debevec 2005): 2^n regions of equal energy, a light at each energy centroid.
+//! - [`VarianceMinimization`] (Viriyothai and Debevec 2009): 2^n regions, each cut where the
+//!   parts' energy-weighted angular variance is smallest.
 //! - [`ImportanceSampled`]: K samples of the map's luminance distribution as equal-power
 //!   lights (a baseline).
 //!
 //! Centre-surround extraction (paper 000), the emissive split with EnvDirects / EnvIndirects
-//! (paper 001) and variance minimization (Viriyothai and Debevec 2009) are the next methods.
+//! (paper 001) are the next methods.
 //!
 //! Outputs: [`Decomposition::to_json`] (`lights.json`), [`Decomposition::to_gltf`] (glTF 2.0 with
 //! `KHR_lights_punctual` directional lights), the remainder map (`ambient.exr`) and an overlay of
@@ -29,7 +31,10 @@ mod importance;
 mod median_cut;
 pub mod output;
 pub mod overlay;
+mod regions;
+mod variance;
 
 pub use decomposition::{Decomposition, ExtractError, ExtractedLight, LightExtractor, interleaved_sets};
 pub use importance::ImportanceSampled;
 pub use median_cut::MedianCut;
+pub use variance::VarianceMinimization;

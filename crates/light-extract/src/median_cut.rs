@@ -7,12 +7,9 @@
 //! cone with its region's solid angle and mean radiance: the regions partition the map, so the
 //! remainder is zero and light power = map power.
 
-use crate::decomposition::{Decomposition, ExtractError, ExtractedLight, LightExtractor};
-use envmap_sphere::latlong::{TexelDirections, latlong_uv_to_dir};
-use envmap_sphere::{EnvMap, SummedAreaTable, luminance};
-use glam::{DVec3, Vec2, Vec3};
-use scene::DistantLight;
-use std::f64::consts::PI;
+use crate::decomposition::{Decomposition, ExtractError, LightExtractor};
+use crate::regions::{Region, partition, subdivide};
+use envmap_sphere::{EnvMap, SummedAreaTable};
 use std::time::Instant;
 
 /// Median cut with 2^`depth` regions.
@@ -37,15 +34,6 @@ impl MedianCut {
     }
 }
 
-/// A half-open texel rectangle.
-#[derive(Clone, Copy, Debug)]
-struct Region {
-    x0: u32,
-    y0: u32,
-    x1: u32,
-    y1: u32,
-}
-
 fn energy(sat: &SummedAreaTable<1>, r: &Region) -> f64 {
     sat.sum(r.x0, r.y0, r.x1, r.y1)[0]
 }
@@ -56,9 +44,7 @@ fn split(sat: &SummedAreaTable<1>, r: Region, w: u32, h: u32) -> Option<(Region,
     if nx <= 1 && ny <= 1 {
         return None;
     }
-    let theta_c = PI * f64::from(r.y0 + r.y1) * 0.5 / f64::from(h);
-    let width = f64::from(nx) * 2.0 * PI / f64::from(w) * theta_c.sin();
-    let height = f64::from(ny) * PI / f64::from(h);
+    let (width, height) = r.angular_size(w, h);
     let along_x = ny <= 1 || (nx > 1 && width >= height);
     let total = energy(sat, &r);
     // Smallest cut c in (lo, hi) whose first part holds at least half the energy; an empty
@@ -83,40 +69,6 @@ fn split(sat: &SummedAreaTable<1>, r: Region, w: u32, h: u32) -> Option<(Region,
     })
 }
 
-/// The light standing for region `r`: energy centroid, region solid angle, mean radiance.
-fn region_light(map: &EnvMap, row_sa: &[f64], dirs: &TexelDirections, r: &Region) -> ExtractedLight {
-    let (mut centroid, mut power, mut solid_angle) = (DVec3::ZERO, DVec3::ZERO, 0.0);
-    for j in r.y0..r.y1 {
-        let sa = row_sa[j as usize];
-        solid_angle += sa * f64::from(r.x1 - r.x0);
-        let (mut row_power, mut row_centroid) = (Vec3::ZERO, Vec3::ZERO);
-        for (i, l) in (r.x0..r.x1).zip(&map.row(j)[r.x0 as usize..r.x1 as usize]) {
-            row_power += *l;
-            row_centroid += dirs.dir(i, j) * luminance(*l).max(0.0);
-        }
-        power += row_power.as_dvec3() * sa;
-        centroid += row_centroid.as_dvec3() * sa;
-    }
-    let (w, h) = (map.width() as f32, map.height() as f32);
-    let uv = |x: u32, y: u32| Vec2::new(x as f32 / w, y as f32 / h);
-    let centre = latlong_uv_to_dir((uv(r.x0, r.y0) + uv(r.x1, r.y1)) * 0.5);
-    let direction = centroid.as_vec3().try_normalize().unwrap_or(centre);
-    let (xm, ym) = ((r.x0 + r.x1) / 2, (r.y0 + r.y1) / 2);
-    let extent =
-        [(r.x0, r.y0), (r.x1, r.y0), (r.x0, r.y1), (r.x1, r.y1), (xm, r.y0), (xm, r.y1), (r.x0, ym), (r.x1, ym)]
-            .iter()
-            .map(|&(x, y)| direction.angle_between(latlong_uv_to_dir(uv(x, y))))
-            .fold(0.0f32, f32::max);
-    ExtractedLight {
-        light: DistantLight {
-            direction,
-            solid_angle: solid_angle as f32,
-            radiance: (power / solid_angle.max(1e-300)).as_vec3(),
-        },
-        extent,
-    }
-}
-
 impl LightExtractor for MedianCut {
     fn extract(&self, map: &EnvMap) -> Result<Decomposition, ExtractError> {
         if self.depth > 24 {
@@ -125,28 +77,7 @@ impl LightExtractor for MedianCut {
         let start = Instant::now();
         let (w, h) = (map.width(), map.height());
         let sat = SummedAreaTable::luminance_power(map);
-        let mut regions = vec![Region { x0: 0, y0: 0, x1: w, y1: h }];
-        for _ in 0..self.depth {
-            let mut next = Vec::with_capacity(regions.len() * 2);
-            for r in regions {
-                match split(&sat, r, w, h) {
-                    Some((a, b)) => next.extend([a, b]),
-                    None => next.push(r),
-                }
-            }
-            regions = next;
-        }
-        let row_sa = map.row_solid_angles();
-        let dirs = TexelDirections::new(w, h);
-        let lights: Vec<ExtractedLight> = regions
-            .iter()
-            .map(|r| region_light(map, &row_sa, &dirs, r))
-            .filter(|l| l.power().max_element() > 0.0)
-            .collect();
-        let ambient = EnvMap::constant(w, h, Vec3::ZERO);
-        let params = serde_json::json!({ "depth": self.depth });
-        let mut d = Decomposition::new("median-cut", params, map, lights, ambient, true);
-        d.time_ms = start.elapsed().as_secs_f64() * 1e3;
-        Ok(d)
+        let regions = subdivide(w, h, self.depth, |r| split(&sat, r, w, h));
+        Ok(partition("median-cut", serde_json::json!({ "depth": self.depth }), map, &regions, start))
     }
 }

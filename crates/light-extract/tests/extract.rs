@@ -3,7 +3,9 @@
 
 use envmap_sphere::{EnvMap, luminance};
 use glam::Vec3;
-use light_extract::{Decomposition, ImportanceSampled, LightExtractor, MedianCut, interleaved_sets};
+use light_extract::{
+    Decomposition, ImportanceSampled, LightExtractor, MedianCut, VarianceMinimization, interleaved_sets,
+};
 use std::f64::consts::PI;
 use std::path::PathBuf;
 
@@ -21,7 +23,11 @@ fn shared_maps() -> Vec<PathBuf> {
 }
 
 fn methods(k: usize) -> Vec<Box<dyn LightExtractor>> {
-    vec![Box::new(MedianCut::with_lights(k)), Box::new(ImportanceSampled { count: k, seed: 1 })]
+    vec![
+        Box::new(MedianCut::with_lights(k)),
+        Box::new(VarianceMinimization::with_lights(k)),
+        Box::new(ImportanceSampled { count: k, seed: 1 }),
+    ]
 }
 
 fn no_nan(d: &Decomposition) {
@@ -37,13 +43,44 @@ fn no_nan(d: &Decomposition) {
 fn median_cut_partitions_every_shared_map() {
     for path in shared_maps() {
         let map = EnvMap::load(&path).unwrap_or_else(|e| panic!("{e}"));
-        let d = MedianCut::default().extract(&map).unwrap_or_else(|e| panic!("{e}"));
-        no_nan(&d);
-        assert!(d.lights.len() <= 32 && d.lights.len() >= 16, "{}: {}", path.display(), d.lights.len());
-        assert!(d.power_balance_error() < 1e-4, "{}: {}", path.display(), d.power_balance_error());
-        let sa: f64 = d.lights.iter().map(|l| f64::from(l.light.solid_angle)).sum();
-        assert!((sa / (4.0 * PI) - 1.0).abs() < 1e-4, "regions tile the sphere: {sa}");
+        let partitions: [Box<dyn LightExtractor>; 2] =
+            [Box::new(MedianCut::default()), Box::new(VarianceMinimization::default())];
+        let mut spread = Vec::new();
+        for m in partitions {
+            let d = m.extract(&map).unwrap_or_else(|e| panic!("{e}"));
+            no_nan(&d);
+            assert!(
+                d.lights.len() <= 32 && d.lights.len() >= 16,
+                "{} {}: {}",
+                d.method,
+                path.display(),
+                d.lights.len()
+            );
+            assert!(d.power_balance_error() < 1e-4, "{} {}: {}", d.method, path.display(), d.power_balance_error());
+            // Only lights with power are kept, so the regions tile the sphere up to black ones.
+            let sa: f64 = d.lights.iter().map(|l| f64::from(l.light.solid_angle)).sum();
+            assert!(sa <= 4.0 * PI * (1.0 + 1e-4), "{}: {sa}", d.method);
+            spread.push(weighted_spread(&map, &d));
+        }
+        // Variance minimization's objective: the energy it leaves spread around the lights.
+        assert!(spread[1] < spread[0], "{}: variance-min {} >= median cut {}", path.display(), spread[1], spread[0]);
     }
+}
+
+/// Sum over texels of luminance x solid angle x squared distance to the nearest light direction
+/// of the same region — approximated by the nearest light overall (the regions are convex).
+fn weighted_spread(map: &EnvMap, d: &Decomposition) -> f64 {
+    let mut total = 0.0;
+    for j in (0..map.height()).step_by(2) {
+        let sa = map.texel_solid_angle(j);
+        for i in (0..map.width()).step_by(2) {
+            let dir = map.texel_dir(i, j);
+            let near =
+                d.lights.iter().map(|l| (l.light.direction - dir).length_squared()).fold(f32::INFINITY, f32::min);
+            total += f64::from(luminance(map.pixel(i, j)) * near) * sa;
+        }
+    }
+    total
 }
 
 #[test]
@@ -154,6 +191,8 @@ fn one_light_and_a_thousand_lights() {
         no_nan(&d);
     }
     assert_eq!(MedianCut::with_lights(33).depth, 5, "the largest power of two not above K");
+    let vm = VarianceMinimization::with_lights(1024).extract(&map).unwrap_or_else(|e| panic!("{e}"));
+    assert!(vm.lights.len() > 800 && vm.power_balance_error() < 1e-4, "{}", vm.lights.len());
 }
 
 #[test]
@@ -251,5 +290,6 @@ fn files_follow_the_documented_schema() {
 fn bad_parameters_are_errors() {
     let map = EnvMap::constant(8, 4, Vec3::ONE);
     assert!(MedianCut { depth: 25 }.extract(&map).is_err());
+    assert!(VarianceMinimization { depth: 25 }.extract(&map).is_err());
     assert!(ImportanceSampled { count: 0, seed: 0 }.extract(&map).is_err());
 }
