@@ -3,6 +3,7 @@
 
 #![allow(clippy::print_stdout, clippy::print_stderr)]
 
+mod eval_lights;
 mod extract;
 mod info;
 mod lavapipe;
@@ -103,6 +104,31 @@ enum Command {
         #[arg(long, default_value_t = 1.0)]
         lux_per_unit: f32,
     },
+    /// Every extraction method against the env-direct truth over maps x scenes: Markdown and CSV
+    /// tables under target/eval-lights (paper 001's Table 1).
+    EvalLights {
+        /// Folder of maps; ../shared/envmaps when absent.
+        #[arg(long)]
+        maps: Option<PathBuf>,
+        /// Comma-separated built-in scenes.
+        #[arg(long, default_value = "spheres_box,glossy_set", value_delimiter = ',')]
+        scenes: Vec<String>,
+        /// Lights per method K.
+        #[arg(long, default_value_t = 32)]
+        lights: usize,
+        /// Samples per pixel of the env-direct truth (its noise floor is reported).
+        #[arg(long, default_value_t = 1024)]
+        spp: u32,
+        /// Samples per pixel of the lights renders (each traces one shadow ray per light).
+        #[arg(long, default_value_t = 32)]
+        lights_spp: u32,
+        /// Image size WIDTHxHEIGHT.
+        #[arg(long, value_parser = parse_size, default_value = "160x120")]
+        size: (u32, u32),
+        /// Output folder.
+        #[arg(long, default_value = "target/eval-lights")]
+        out: PathBuf,
+    },
     /// RMSE and FLIP of TEST against REF (two lines).
     Compare {
         /// Reference image (.exr or .hdr).
@@ -160,6 +186,17 @@ fn main() -> ExitCode {
             aovs,
         }),
         Command::Compare { reference, test } => render::compare(&reference, &test),
+        Command::EvalLights { maps, scenes, lights, spp, lights_spp, size, out } => {
+            eval_lights::run(&eval_lights::EvalArgs {
+                maps: maps.unwrap_or_else(eval_lights::default_maps_dir),
+                scenes,
+                lights,
+                spp,
+                lights_spp,
+                size,
+                out,
+            })
+        }
         Command::Extract { path, method, lights, out, lux_per_unit } => {
             extract::run(&path, &method, lights, out.as_deref(), lux_per_unit)
         }

@@ -37,6 +37,15 @@ pub fn load_map(path: Option<&Path>) -> Result<EnvMap, String> {
 #[derive(Deserialize)]
 struct LightsFile {
     lights: Vec<LightEntry>,
+    #[serde(default)]
+    interleaved: Vec<Vec<LightEntry>>,
+}
+
+/// What a `lights.json` holds for rendering.
+pub struct LightsData {
+    pub lights: Vec<DistantLight>,
+    pub interleaved: Vec<Vec<DistantLight>>,
+    pub ambient: Option<Sh9>,
 }
 
 #[derive(Deserialize)]
@@ -46,32 +55,45 @@ struct LightEntry {
     radiance: [f32; 3],
 }
 
-/// Lights from a `lights.json` (the light-extract schema; only `lights[].direction`,
-/// `solid_angle` and `radiance` are read) and, when an `ambient.exr` sits beside it, its SH9.
-pub fn load_lights(path: &Path) -> Result<(Vec<DistantLight>, Option<Sh9>), String> {
+fn parse_lights(path: &Path, entries: &[LightEntry]) -> Result<Vec<DistantLight>, String> {
+    entries
+        .iter()
+        .enumerate()
+        .map(|(k, l)| {
+            let d = Vec3::from_array(l.direction);
+            let r = Vec3::from_array(l.radiance);
+            let ok = d.is_finite()
+                && d.length() > 0.0
+                && l.solid_angle > 0.0
+                && l.solid_angle <= 4.0 * std::f32::consts::PI
+                && r.is_finite()
+                && r.min_element() >= 0.0;
+            if !ok {
+                return Err(format!(
+                    "{}: light {k} is invalid (direction must be non-zero, solid_angle in (0, 4 pi], radiance finite and non-negative)",
+                    path.display()
+                ));
+            }
+            Ok(DistantLight { direction: d.normalize(), solid_angle: l.solid_angle, radiance: r })
+        })
+        .collect()
+}
+
+/// Lights from a `lights.json` (the light-extract schema; `lights[]` and `interleaved[][]` with
+/// their `direction`, `solid_angle` and `radiance` are read) and, when an `ambient.exr` sits
+/// beside it, its SH9.
+pub fn load_lights(path: &Path) -> Result<LightsData, String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let file: LightsFile = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
-    let mut lights = Vec::with_capacity(file.lights.len());
-    for (k, l) in file.lights.iter().enumerate() {
-        let d = Vec3::from_array(l.direction);
-        let r = Vec3::from_array(l.radiance);
-        let ok =
-            d.is_finite() && d.length() > 0.0 && l.solid_angle > 0.0 && l.solid_angle <= 4.0 * std::f32::consts::PI;
-        if !ok || !r.is_finite() || r.min_element() < 0.0 {
-            return Err(format!(
-                "{}: light {k} is invalid (direction must be non-zero, solid_angle in (0, 4 pi], radiance finite and non-negative)",
-                path.display()
-            ));
-        }
-        lights.push(DistantLight { direction: d.normalize(), solid_angle: l.solid_angle, radiance: r });
-    }
+    let lights = parse_lights(path, &file.lights)?;
+    let interleaved = file.interleaved.iter().map(|set| parse_lights(path, set)).collect::<Result<_, _>>()?;
     let ambient_path = path.with_file_name("ambient.exr");
     let ambient = if ambient_path.exists() {
         Some(Sh9::project(&EnvMap::load(&ambient_path).map_err(|e| e.to_string())?))
     } else {
         None
     };
-    Ok((lights, ambient))
+    Ok(LightsData { lights, interleaved, ambient })
 }
 
 pub fn run(args: &RenderArgs) -> Result<(), String> {
@@ -95,10 +117,11 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         "env-direct" => Integrator::EnvDirect(Strategy::Mis),
         "path" => Integrator::Path { max_depth: args.max_depth.max(1) },
         "lights" => {
-            let (lights, ambient) = light_data.as_ref().ok_or("--integrator lights needs --lights LIGHTS.json")?;
+            let data = light_data.as_ref().ok_or("--integrator lights needs --lights LIGHTS.json")?;
             Integrator::Lights(LightSet {
-                lights,
-                ambient: *ambient,
+                lights: &data.lights,
+                interleaved: &data.interleaved,
+                ambient: data.ambient,
                 shadow_ambient: args.shadow_ambient,
                 background: Some(&map),
             })

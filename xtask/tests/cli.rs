@@ -214,3 +214,40 @@ fn extract_writes_the_four_files_and_a_line_per_light() {
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("median-cut, variance-min, importance"));
 }
+
+#[test]
+fn eval_lights_writes_both_tables_with_a_noise_floor() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli-eval");
+    let maps = dir.join("maps");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&maps).expect("scratch dir");
+    std::fs::copy(shared("venice_sunset_1k.hdr"), maps.join("venice.hdr")).expect("copy map");
+    let out_dir = dir.join("out");
+    let out = xtask(&[
+        "eval-lights",
+        "--maps",
+        maps.to_str().unwrap_or_default(),
+        "--scenes",
+        "spheres_box",
+        "--lights",
+        "4",
+        "--spp",
+        "4",
+        "--lights-spp",
+        "2",
+        "--size",
+        "16x12",
+        "--out",
+        out_dir.to_str().unwrap_or_default(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let csv = std::fs::read_to_string(out_dir.join("eval-lights.csv")).expect("csv");
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(lines[0], "map,scene,method,lights,rmse,flip,extract_ms");
+    assert_eq!(lines.len(), 1 + 4, "floor + three methods: {csv}");
+    for method in ["median-cut", "variance-min", "importance", "(reference, other seed)"] {
+        assert!(csv.contains(&format!(",{method},")), "{method} missing:\n{csv}");
+    }
+    let md = std::fs::read_to_string(out_dir.join("eval-lights.md")).expect("md");
+    assert!(md.contains("| median-cut |") && md.contains("RMSE / median cut"), "{md}");
+}

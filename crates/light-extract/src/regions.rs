@@ -29,6 +29,11 @@ impl Region {
     }
 }
 
+/// Rounds of splitting for at most `k` lights: the largest n with 2^n <= max(k, 1).
+pub(crate) fn depth_for_lights(k: usize) -> u32 {
+    usize::BITS - 1 - k.max(1).leading_zeros()
+}
+
 /// `depth` rounds of splitting every region with `split` (a region it cannot split stays).
 pub(crate) fn subdivide(w: u32, h: u32, depth: u32, split: impl Fn(Region) -> Option<(Region, Region)>) -> Vec<Region> {
     let mut regions = vec![Region { x0: 0, y0: 0, x1: w, y1: h }];

@@ -32,7 +32,7 @@ impl VarianceMinimization {
     /// The largest power of two of lights not above `k` (at least 1).
     #[must_use]
     pub fn with_lights(k: usize) -> Self {
-        Self { depth: usize::BITS - 1 - k.max(1).leading_zeros() }
+        Self { depth: crate::regions::depth_for_lights(k) }
     }
 }
 

@@ -49,6 +49,10 @@ impl<'a> EnvLight<'a> {
 pub struct LightSet<'a> {
     /// Distant cone lights.
     pub lights: &'a [DistantLight],
+    /// Extra light sets of interleaved sampling (paper 001, section 3.5): each sample uses
+    /// `lights` or one of these, uniformly — the converged result of interleaving followed by a
+    /// perfect filter. Empty: `lights` only.
+    pub interleaved: &'a [Vec<DistantLight>],
     /// Ambient radiance as SH9 (its irradiance lights the diffuse lobe), if any.
     pub ambient: Option<Sh9>,
     /// Shadow the ambient term by sampling visibility (cosine-weighted) instead of leaving it
@@ -180,7 +184,13 @@ fn env_direct(
 
 fn lights_direct(bvh: &SceneBvh, set: &LightSet, sh: &Shading, s: &mut PixelSampler) -> Vec3 {
     let mut l = Vec3::ZERO;
-    for light in set.lights {
+    let lights = if set.interleaved.is_empty() {
+        set.lights
+    } else {
+        let k = (s.next_1d() * (set.interleaved.len() + 1) as f32) as usize;
+        if k == 0 { set.lights } else { &set.interleaved[(k - 1).min(set.interleaved.len() - 1)] }
+    };
+    for light in lights {
         let (dir, pdf) = light.sample_direction(s.next_2d());
         let (fc, _) = sh.f_cos(dir);
         if fc != Vec3::ZERO && !bvh.occluded(sh.origin(), dir, f32::INFINITY) {

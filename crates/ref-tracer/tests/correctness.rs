@@ -166,7 +166,8 @@ fn one_light_over_the_whole_sphere_equals_the_constant_map() {
     let l = Vec3::new(0.5, 1.0, 2.0);
     let map = EnvMap::constant(32, 16, l);
     let lights = [DistantLight { direction: Vec3::Y, solid_angle: 4.0 * std::f32::consts::PI, radiance: l }];
-    let set = LightSet { lights: &lights, ambient: None, shadow_ambient: false, background: Some(&map) };
+    let set =
+        LightSet { lights: &lights, interleaved: &[], ambient: None, shadow_ambient: false, background: Some(&map) };
     let (m_lights, e1) = image_mean(&scene, &map, &Integrator::Lights(set), 16, 8);
     let (m_env, e2) = image_mean(&scene, &map, &Integrator::EnvDirect(Strategy::Mis), 16, 8);
     let sigma = (e1 * e1 + e2 * e2).sqrt();
@@ -199,7 +200,7 @@ fn a_tiny_cone_shades_like_a_directional_light() {
         solid_angle: omega,
         radiance: Vec3::splat(1.0 / omega),
     }];
-    let set = LightSet { lights: &lights, ambient: None, shadow_ambient: false, background: None };
+    let set = LightSet { lights: &lights, interleaved: &[], ambient: None, shadow_ambient: false, background: None };
     let r = run(&plane, None, &Integrator::Lights(set), 4, 2);
     let want = 0.6 / std::f32::consts::PI * theta.cos();
     for c in &r.color {
@@ -214,7 +215,7 @@ fn ambient_sh9_lights_the_diffuse_lobe() {
     let sh = Sh9::project(&EnvMap::constant(64, 32, l));
     let mut scene = small("three_boxes", 16, 12);
     scene.objects.truncate(1); // the ground alone
-    let set = LightSet { lights: &[], ambient: Some(sh), shadow_ambient: false, background: None };
+    let set = LightSet { lights: &[], interleaved: &[], ambient: Some(sh), shadow_ambient: false, background: None };
     let r = run(&scene, None, &Integrator::Lights(set), 1, 0);
     for (k, c) in r.color.iter().enumerate() {
         if interior(&r, k, 0) {
@@ -222,7 +223,7 @@ fn ambient_sh9_lights_the_diffuse_lobe() {
         }
     }
     // Shadowed by sampling, it converges to the same on an unoccluded plane.
-    let set = LightSet { lights: &[], ambient: Some(sh), shadow_ambient: true, background: None };
+    let set = LightSet { lights: &[], interleaved: &[], ambient: Some(sh), shadow_ambient: true, background: None };
     let r = run(&scene, None, &Integrator::Lights(set), 64, 0);
     let (mean, n) = object_mean(&r, 0);
     assert!(n > 50 && (mean - l * 0.5).abs().max_element() < 0.01, "{mean}");

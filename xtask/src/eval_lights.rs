@@ -1,0 +1,202 @@
+//! `cargo xtask eval-lights`: every extraction method against the `env-direct` truth, over maps
+//! x scenes, as paper 001's Table 1: mean RMSE and FLIP per method, their ratio to median cut,
+//! and the mean rank. Writes `DIR/eval-lights.csv` (one row per map, scene and method) and
+//! `DIR/eval-lights.md`.
+
+use crate::render::load_map;
+use light_extract::{ImportanceSampled, LightExtractor, MedianCut, VarianceMinimization, interleaved_sets};
+use ref_tracer::metrics::{FlipTonemap, flip, rmse};
+use ref_tracer::{EnvLight, Integrator, LightSet, RenderSettings, SceneBvh, Strategy};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+pub struct EvalArgs {
+    pub maps: PathBuf,
+    pub scenes: Vec<String>,
+    pub lights: usize,
+    pub spp: u32,
+    pub lights_spp: u32,
+    pub size: (u32, u32),
+    pub out: PathBuf,
+}
+
+struct Row {
+    map: String,
+    scene: String,
+    method: String,
+    lights: usize,
+    rmse: f64,
+    flip: f64,
+    extract_ms: f64,
+}
+
+fn methods(k: usize) -> Vec<Box<dyn LightExtractor>> {
+    vec![
+        Box::new(MedianCut::with_lights(k)),
+        Box::new(VarianceMinimization::with_lights(k)),
+        Box::new(ImportanceSampled { count: k, seed: 0 }),
+    ]
+}
+
+pub fn run(args: &EvalArgs) -> Result<(), String> {
+    let mut maps: Vec<PathBuf> = std::fs::read_dir(&args.maps)
+        .map_err(|e| format!("{}: {e}", args.maps.display()))?
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "exr" || x == "hdr"))
+        .collect();
+    maps.sort();
+    if maps.is_empty() {
+        return Err(format!("{}: no .exr or .hdr maps", args.maps.display()));
+    }
+    let n_methods = methods(args.lights).len();
+    let bar = indicatif::ProgressBar::new((maps.len() * args.scenes.len() * (2 + n_methods)) as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "eval-lights [{bar:40}] {pos}/{len} renders, {elapsed} (eta {eta}) {msg}",
+        )
+        .map_err(|e| e.to_string())?,
+    );
+    let mut rows = Vec::new();
+    for map_path in &maps {
+        let map = load_map(Some(map_path))?;
+        let map_name = map_path.file_name().map_or_else(String::new, |n| n.to_string_lossy().to_string());
+        let env = EnvLight::new(&map);
+        let decompositions: Vec<_> = methods(args.lights)
+            .iter()
+            .map(|m| m.extract(&map).map_err(|e| format!("{}: {e}", map_path.display())))
+            .collect::<Result<_, _>>()?;
+        for scene_name in &args.scenes {
+            let mut scene = scene::Scene::builtin(scene_name).map_err(|e| e.to_string())?;
+            (scene.camera.width, scene.camera.height) = args.size;
+            let bvh = SceneBvh::new(&scene);
+            bar.set_message(format!("{map_name} / {scene_name}"));
+            let truth = RenderSettings { spp: args.spp, seed: 1, time_budget: None, aovs: false };
+            let reference =
+                ref_tracer::render(&scene, &bvh, Some(&env), &Integrator::EnvDirect(Strategy::Mis), &truth, &|_, _| {});
+            bar.inc(1);
+            let tm = FlipTonemap::for_reference(&reference.color);
+            // The noise floor: the same truth with another seed.
+            let again = RenderSettings { seed: 3, ..truth };
+            let floor =
+                ref_tracer::render(&scene, &bvh, Some(&env), &Integrator::EnvDirect(Strategy::Mis), &again, &|_, _| {});
+            bar.inc(1);
+            rows.push(Row {
+                map: map_name.clone(),
+                scene: scene_name.clone(),
+                method: "(reference, other seed)".into(),
+                lights: 0,
+                rmse: rmse(&reference.color, &floor.color),
+                flip: flip(&reference.color, &floor.color, floor.width, floor.height, &tm),
+                extract_ms: 0.0,
+            });
+            for d in &decompositions {
+                let lights = d.distant_lights();
+                let sets: Vec<Vec<scene::DistantLight>> = interleaved_sets(&d.lights, 8, 0.1, 0)[1..]
+                    .iter()
+                    .map(|s| s.iter().map(|l| l.light).collect())
+                    .collect();
+                let set = LightSet {
+                    lights: &lights,
+                    interleaved: &sets,
+                    ambient: Some(d.ambient_sh),
+                    shadow_ambient: false,
+                    background: Some(&map),
+                };
+                let settings = RenderSettings { spp: args.lights_spp.max(1), seed: 2, time_budget: None, aovs: false };
+                let img = ref_tracer::render(&scene, &bvh, None, &Integrator::Lights(set), &settings, &|_, _| {});
+                bar.inc(1);
+                rows.push(Row {
+                    map: map_name.clone(),
+                    scene: scene_name.clone(),
+                    method: d.method.clone(),
+                    lights: d.lights.len(),
+                    rmse: rmse(&reference.color, &img.color),
+                    flip: flip(&reference.color, &img.color, img.width, img.height, &tm),
+                    extract_ms: d.time_ms,
+                });
+            }
+        }
+    }
+    bar.finish_and_clear();
+    write_tables(&rows, args)
+}
+
+/// Mean of `value` per method, the ratio of means to median cut's, and the mean rank.
+fn summary(rows: &[Row], value: impl Fn(&Row) -> f64) -> Vec<(String, f64, f64)> {
+    let mut names: Vec<String> = rows.iter().map(|r| r.method.clone()).collect();
+    names.dedup();
+    names.sort();
+    names.dedup();
+    let cases: Vec<(String, String)> = {
+        let mut c: Vec<_> = rows.iter().map(|r| (r.map.clone(), r.scene.clone())).collect();
+        c.dedup();
+        c
+    };
+    names
+        .iter()
+        .map(|m| {
+            let mine: Vec<&Row> = rows.iter().filter(|r| &r.method == m).collect();
+            let mean = mine.iter().map(|r| value(r)).sum::<f64>() / mine.len().max(1) as f64;
+            let rank = cases
+                .iter()
+                .map(|(map, scene)| {
+                    let case: Vec<&Row> = rows.iter().filter(|r| &r.map == map && &r.scene == scene).collect();
+                    let mine = case.iter().find(|r| &r.method == m).map_or(f64::INFINITY, |r| value(r));
+                    1.0 + case.iter().filter(|r| value(r) < mine).count() as f64
+                })
+                .sum::<f64>()
+                / cases.len().max(1) as f64;
+            (m.clone(), mean, rank)
+        })
+        .collect()
+}
+
+fn write_tables(rows: &[Row], args: &EvalArgs) -> Result<(), String> {
+    std::fs::create_dir_all(&args.out).map_err(|e| format!("{}: {e}", args.out.display()))?;
+    let mut csv = String::from("map,scene,method,lights,rmse,flip,extract_ms\n");
+    for r in rows {
+        let _ = writeln!(
+            csv,
+            "{},{},{},{},{:.6},{:.6},{:.3}",
+            r.map, r.scene, r.method, r.lights, r.rmse, r.flip, r.extract_ms
+        );
+    }
+    let (rm, fl) = (summary(rows, |r| r.rmse), summary(rows, |r| r.flip));
+    let base = |s: &[(String, f64, f64)]| s.iter().find(|(m, _, _)| m == "median-cut").map_or(f64::NAN, |x| x.1);
+    let (brm, bfl) = (base(&rm), base(&fl));
+    let mut md = String::new();
+    let _ = writeln!(
+        md,
+        "# Light extraction against the env-direct truth\n\n{} maps x scenes {}, K = {}, {} x {}, reference {} spp, \
+         lights renders {} spp with 8 interleaved sets. \"(reference, other seed)\" is the noise floor: \
+         the truth rendered again with another seed.\n",
+        rows.iter().map(|r| &r.map).collect::<std::collections::BTreeSet<_>>().len(),
+        args.scenes.join(", "),
+        args.lights,
+        args.size.0,
+        args.size.1,
+        args.spp,
+        args.lights_spp
+    );
+    let _ = writeln!(
+        md,
+        "| method | mean RMSE | RMSE / median cut | mean rank (RMSE) | mean FLIP | FLIP / median cut | mean rank (FLIP) |"
+    );
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|");
+    for ((m, r, rr), (_, f, fr)) in rm.iter().zip(&fl) {
+        let _ = writeln!(md, "| {m} | {r:.4} | {:.2} | {rr:.2} | {f:.4} | {:.2} | {fr:.2} |", r / brm, f / bfl);
+    }
+    let csv_path = args.out.join("eval-lights.csv");
+    let md_path = args.out.join("eval-lights.md");
+    std::fs::write(&csv_path, csv).map_err(|e| format!("{}: {e}", csv_path.display()))?;
+    std::fs::write(&md_path, &md).map_err(|e| format!("{}: {e}", md_path.display()))?;
+    print!("{md}");
+    println!("\nwrote {} and {}", csv_path.display(), md_path.display());
+    Ok(())
+}
+
+/// `../shared/envmaps` beside the workspace.
+pub fn default_maps_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/envmaps")
+}
