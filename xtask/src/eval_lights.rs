@@ -4,7 +4,9 @@
 //! `DIR/eval-lights.md`.
 
 use crate::render::load_map;
-use light_extract::{ImportanceSampled, LightExtractor, MedianCut, VarianceMinimization, interleaved_sets};
+use light_extract::{
+    CenterSurround, ImportanceSampled, LightExtractor, MedianCut, VarianceMinimization, interleaved_sets,
+};
 use ref_tracer::metrics::{FlipTonemap, flip, rmse};
 use ref_tracer::{EnvLight, Integrator, LightSet, RenderSettings, SceneBvh, Strategy};
 use std::fmt::Write as _;
@@ -32,6 +34,7 @@ struct Row {
 
 fn methods(k: usize) -> Vec<Box<dyn LightExtractor>> {
     vec![
+        Box::new(CenterSurround { max_lights: k, ..CenterSurround::default() }),
         Box::new(MedianCut::with_lights(k)),
         Box::new(VarianceMinimization::with_lights(k)),
         Box::new(ImportanceSampled { count: k, seed: 0 }),

@@ -3,14 +3,15 @@
 //! power + remainder power = map power.
 //!
 //! Methods, each a type implementing [`LightExtractor`] with its parameters as fields:
+//! - [`CenterSurround`] (paper 000): circular centre-surround filters, iterative extraction,
+//!   Weber's 2 % stop; the remainder is the ambient map.
 //! - [`MedianCut`] (Debevec 2005): 2^n regions of equal energy, a light at each energy centroid.
 //! - [`VarianceMinimization`] (Viriyothai and Debevec 2009): 2^n regions, each cut where the
 //!   parts' energy-weighted angular variance is smallest.
 //! - [`ImportanceSampled`]: K samples of the map's luminance distribution as equal-power
 //!   lights (a baseline).
 //!
-//! Centre-surround extraction (paper 000), the emissive split with EnvDirects / EnvIndirects
-//! (paper 001) are the next methods.
+//! The emissive split with EnvDirects / EnvIndirects (paper 001) is the next method.
 //!
 //! Outputs: [`Decomposition::to_json`] (`lights.json`), [`Decomposition::to_gltf`] (glTF 2.0 with
 //! `KHR_lights_punctual` directional lights), the remainder map (`ambient.exr`) and an overlay of
@@ -26,6 +27,7 @@
 //!
 //! Architecture invariant: knows lights, never wgpu.
 
+mod center_surround;
 mod decomposition;
 mod importance;
 mod median_cut;
@@ -34,6 +36,7 @@ pub mod overlay;
 mod regions;
 mod variance;
 
+pub use center_surround::CenterSurround;
 pub use decomposition::{Decomposition, ExtractError, ExtractedLight, LightExtractor, interleaved_sets};
 pub use importance::ImportanceSampled;
 pub use median_cut::MedianCut;

@@ -4,7 +4,7 @@
 use envmap_sphere::{EnvMap, luminance};
 use glam::Vec3;
 use light_extract::{
-    Decomposition, ImportanceSampled, LightExtractor, MedianCut, VarianceMinimization, interleaved_sets,
+    CenterSurround, Decomposition, ImportanceSampled, LightExtractor, MedianCut, VarianceMinimization, interleaved_sets,
 };
 use std::f64::consts::PI;
 use std::path::PathBuf;
@@ -27,6 +27,7 @@ fn methods(k: usize) -> Vec<Box<dyn LightExtractor>> {
         Box::new(MedianCut::with_lights(k)),
         Box::new(VarianceMinimization::with_lights(k)),
         Box::new(ImportanceSampled { count: k, seed: 1 }),
+        Box::new(CenterSurround { max_lights: k, ..CenterSurround::default() }),
     ]
 }
 
@@ -291,5 +292,70 @@ fn bad_parameters_are_errors() {
     let map = EnvMap::constant(8, 4, Vec3::ONE);
     assert!(MedianCut { depth: 25 }.extract(&map).is_err());
     assert!(VarianceMinimization { depth: 25 }.extract(&map).is_err());
+    assert!(CenterSurround { inner_ratio: 1.5, ..CenterSurround::default() }.extract(&map).is_err());
     assert!(ImportanceSampled { count: 0, seed: 0 }.extract(&map).is_err());
+}
+
+fn luminous(p: Vec3) -> f64 {
+    f64::from(luminance(p))
+}
+
+#[test]
+fn center_surround_keeps_exact_books_and_weber_on_every_shared_map() {
+    for path in shared_maps() {
+        let map = EnvMap::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        let d = CenterSurround::default().extract(&map).unwrap_or_else(|e| panic!("{e}"));
+        no_nan(&d);
+        assert!(d.power_balance_error() < 1e-6, "{}: {}", path.display(), d.power_balance_error());
+        let mut found = 0.0;
+        for (k, l) in d.lights.iter().enumerate() {
+            let y = luminous(l.power());
+            assert!(k == 0 || y >= 0.02 * found, "{}: light {k} ({y}) is below 2% of {found}", path.display());
+            found += y;
+        }
+    }
+}
+
+#[test]
+fn center_surround_finds_nothing_in_a_constant_map() {
+    let d = CenterSurround::default()
+        .extract(&EnvMap::constant(256, 128, Vec3::splat(2.0)))
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert!(d.lights.is_empty());
+    assert!(d.power_balance_error() < 1e-9, "everything is ambient");
+}
+
+#[test]
+fn a_sun_across_the_seam_is_one_light() {
+    // Two texels either side of u = 0 on the same row: one sun split by the seam.
+    let mut map = EnvMap::constant(512, 256, Vec3::splat(0.05));
+    for i in [0, 511] {
+        map.set_pixel(i, 100, Vec3::splat(20_000.0));
+    }
+    let d = CenterSurround::default().extract(&map).unwrap_or_else(|e| panic!("{e}"));
+    let sun_power = 2.0 * 20_000.0 * map.texel_solid_angle(100);
+    let at_sun: Vec<_> =
+        d.lights.iter().filter(|l| l.light.direction.z < -0.5 && l.light.direction.x.abs() < 0.05).collect();
+    assert_eq!(at_sun.len(), 1, "{:?}", d.lights);
+    assert!(f64::from(at_sun[0].power().x) / sun_power > 0.99, "the one light holds both halves");
+}
+
+#[test]
+fn rotating_the_map_by_whole_columns_rotates_the_lights() {
+    // 128 columns of 1024 = 45 degrees, a multiple of the coarsest pyramid level's texel.
+    let map = envmap_sphere::default_map();
+    let a = CenterSurround::default().extract(&map).unwrap_or_else(|e| panic!("{e}"));
+    let b = CenterSurround::default().extract(&map.rotate_columns(128)).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(a.lights.len(), b.lights.len());
+    let rot = glam::Quat::from_rotation_y(-std::f32::consts::FRAC_PI_4); // phi grows: x -> -z side
+    for (la, lb) in a.lights.iter().zip(&b.lights) {
+        let want = rot * la.light.direction;
+        let got = lb.light.direction;
+        // either sign convention of the azimuth: the test pins the one the map uses
+        assert!(
+            (got - want).length() < 1e-4 || (got - rot.inverse() * la.light.direction).length() < 1e-4,
+            "{got} vs {want}"
+        );
+        assert!((lb.power() - la.power()).abs().max_element() <= 1e-4 * la.power().max_element());
+    }
 }
