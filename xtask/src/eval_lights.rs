@@ -5,7 +5,7 @@
 
 use crate::render::load_map;
 use light_extract::{
-    CenterSurround, ImportanceSampled, LightExtractor, MedianCut, VarianceMinimization, interleaved_sets,
+    CenterSurround, EmissiveSplit, ImportanceSampled, LightExtractor, MedianCut, VarianceMinimization, interleaved_sets,
 };
 use ref_tracer::metrics::{FlipTonemap, flip, rmse};
 use ref_tracer::{EnvLight, Integrator, LightSet, RenderSettings, SceneBvh, Strategy};
@@ -34,6 +34,7 @@ struct Row {
 
 fn methods(k: usize) -> Vec<Box<dyn LightExtractor>> {
     vec![
+        Box::new(EmissiveSplit { lights: k, ..EmissiveSplit::default() }),
         Box::new(CenterSurround { max_lights: k, ..CenterSurround::default() }),
         Box::new(MedianCut::with_lights(k)),
         Box::new(VarianceMinimization::with_lights(k)),

@@ -2,16 +2,17 @@
 //! lights + ambient and write lights.json, ambient.exr, lights.gltf and overlay.png.
 
 use light_extract::{
-    CenterSurround, ImportanceSampled, LightExtractor, MedianCut, VarianceMinimization, interleaved_sets,
+    CenterSurround, EmissiveSplit, ImportanceSampled, LightExtractor, MedianCut, VarianceMinimization, interleaved_sets,
 };
 use std::path::Path;
 
 /// Methods available now (the paper methods join as they land).
-pub const METHODS: [&str; 4] = ["center-surround", "median-cut", "variance-min", "importance"];
+pub const METHODS: [&str; 5] = ["emissive-split", "center-surround", "median-cut", "variance-min", "importance"];
 
 pub fn run(path: &Path, method: &str, k: usize, out: Option<&Path>, lux_per_unit: f32) -> Result<(), String> {
     let map = envmap_sphere::EnvMap::load(path).map_err(|e| e.to_string())?;
     let extractor: Box<dyn LightExtractor> = match method {
+        "emissive-split" => Box::new(EmissiveSplit { lights: k, ..EmissiveSplit::default() }),
         "center-surround" => Box::new(CenterSurround { max_lights: k, ..CenterSurround::default() }),
         "median-cut" => Box::new(MedianCut::with_lights(k)),
         "variance-min" => Box::new(VarianceMinimization::with_lights(k)),

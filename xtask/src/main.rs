@@ -91,7 +91,8 @@ enum Command {
     Extract {
         /// The map (.exr or .hdr).
         path: PathBuf,
-        /// center-surround (stops by Weber's law; K is a cap), median-cut, variance-min or importance.
+        /// emissive-split, center-surround (stops by Weber's law; K is a cap), median-cut,
+        /// variance-min or importance.
         #[arg(long, default_value = "median-cut")]
         method: String,
         /// Number of lights K (median cut uses the largest power of two not above K).

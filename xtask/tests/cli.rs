@@ -212,7 +212,10 @@ fn extract_writes_the_four_files_and_a_line_per_light() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let out = xtask(&["extract", map.to_str().unwrap_or_default(), "--method", "nope"]);
     assert_eq!(out.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("center-surround, median-cut, variance-min, importance"));
+    assert!(
+        String::from_utf8_lossy(&out.stderr)
+            .contains("emissive-split, center-surround, median-cut, variance-min, importance")
+    );
 }
 
 #[test]
@@ -244,8 +247,10 @@ fn eval_lights_writes_both_tables_with_a_noise_floor() {
     let csv = std::fs::read_to_string(out_dir.join("eval-lights.csv")).expect("csv");
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines[0], "map,scene,method,lights,rmse,flip,extract_ms");
-    assert_eq!(lines.len(), 1 + 5, "floor + four methods: {csv}");
-    for method in ["center-surround", "median-cut", "variance-min", "importance", "(reference, other seed)"] {
+    assert_eq!(lines.len(), 1 + 6, "floor + five methods: {csv}");
+    for method in
+        ["emissive-split", "center-surround", "median-cut", "variance-min", "importance", "(reference, other seed)"]
+    {
         assert!(csv.contains(&format!(",{method},")), "{method} missing:\n{csv}");
     }
     let md = std::fs::read_to_string(out_dir.join("eval-lights.md")).expect("md");

@@ -11,7 +11,8 @@
 //! - [`ImportanceSampled`]: K samples of the map's luminance distribution as equal-power
 //!   lights (a baseline).
 //!
-//! The emissive split with EnvDirects / EnvIndirects (paper 001) is the next method.
+//! - [`EmissiveSplit`] (paper 001): emissive texels -> EnvDirects (importance sampling, masking,
+//!   k-means), the rest -> EnvIndirects (an illumination cut over a binary light tree).
 //!
 //! Outputs: [`Decomposition::to_json`] (`lights.json`), [`Decomposition::to_gltf`] (glTF 2.0 with
 //! `KHR_lights_punctual` directional lights), the remainder map (`ambient.exr`) and an overlay of
@@ -29,6 +30,7 @@
 
 mod center_surround;
 mod decomposition;
+mod emissive_split;
 mod importance;
 mod median_cut;
 pub mod output;
@@ -38,6 +40,7 @@ mod variance;
 
 pub use center_surround::CenterSurround;
 pub use decomposition::{Decomposition, ExtractError, ExtractedLight, LightExtractor, interleaved_sets};
+pub use emissive_split::EmissiveSplit;
 pub use importance::ImportanceSampled;
 pub use median_cut::MedianCut;
 pub use variance::VarianceMinimization;

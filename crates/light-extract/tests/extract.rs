@@ -4,7 +4,8 @@
 use envmap_sphere::{EnvMap, luminance};
 use glam::Vec3;
 use light_extract::{
-    CenterSurround, Decomposition, ImportanceSampled, LightExtractor, MedianCut, VarianceMinimization, interleaved_sets,
+    CenterSurround, Decomposition, EmissiveSplit, ImportanceSampled, LightExtractor, MedianCut, VarianceMinimization,
+    interleaved_sets,
 };
 use std::f64::consts::PI;
 use std::path::PathBuf;
@@ -28,6 +29,7 @@ fn methods(k: usize) -> Vec<Box<dyn LightExtractor>> {
         Box::new(VarianceMinimization::with_lights(k)),
         Box::new(ImportanceSampled { count: k, seed: 1 }),
         Box::new(CenterSurround { max_lights: k, ..CenterSurround::default() }),
+        Box::new(EmissiveSplit { lights: k, ..EmissiveSplit::default() }),
     ]
 }
 
@@ -358,4 +360,54 @@ fn rotating_the_map_by_whole_columns_rotates_the_lights() {
         );
         assert!((lb.power() - la.power()).abs().max_element() <= 1e-4 * la.power().max_element());
     }
+}
+
+fn directs(d: &Decomposition) -> usize {
+    d.params["env_directs"].as_u64().unwrap_or(u64::MAX) as usize
+}
+
+#[test]
+fn emissive_split_partitions_every_shared_map_with_its_ablations() {
+    for path in shared_maps() {
+        let map = EnvMap::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        for (masking, kmeans) in [(true, true), (false, true), (true, false), (false, false)] {
+            let d = EmissiveSplit { masking, kmeans, ..EmissiveSplit::default() }
+                .extract(&map)
+                .unwrap_or_else(|e| panic!("{e}"));
+            no_nan(&d);
+            assert!(d.lights.len() <= 32, "{}: {}", path.display(), d.lights.len());
+            assert!(
+                d.power_balance_error() < 1e-4,
+                "{} {masking} {kmeans}: {}",
+                path.display(),
+                d.power_balance_error()
+            );
+            // EnvDirects sit on emissive texels: brighter than the map's mean radiance there
+            for l in &d.lights[..directs(&d)] {
+                assert!(luminance(map.lookup_nearest(l.light.direction)) > 0.0, "{}: {l:?}", path.display());
+            }
+        }
+    }
+}
+
+#[test]
+fn a_constant_map_has_no_env_directs() {
+    let d = EmissiveSplit::default().extract(&EnvMap::constant(256, 128, Vec3::ONE)).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(directs(&d), 0);
+    assert_eq!(d.lights.len(), 32, "the whole budget goes to EnvIndirects");
+    assert!(d.power_balance_error() < 1e-6);
+}
+
+#[test]
+fn emissive_split_finds_one_sun_across_the_seam() {
+    let mut map = EnvMap::constant(512, 256, Vec3::splat(0.05));
+    for i in [0, 511] {
+        map.set_pixel(i, 100, Vec3::splat(20_000.0));
+    }
+    let d = EmissiveSplit::default().extract(&map).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(directs(&d), 1, "{:?}", &d.lights[..directs(&d)]);
+    let sun = d.lights[0];
+    assert!(sun.light.direction.z < -0.5 && sun.light.direction.x.abs() < 0.01, "{sun:?}");
+    let sun_power = 2.0 * 20_000.0 * map.texel_solid_angle(100);
+    assert!((f64::from(sun.power().x) / sun_power - 1.0).abs() < 1e-3);
 }
