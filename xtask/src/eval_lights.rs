@@ -1,6 +1,7 @@
 //! `cargo xtask eval-lights`: every extraction method against the `env-direct` truth, over maps
 //! x scenes, as paper 001's Table 1: mean RMSE and FLIP per method, their ratio to median cut,
-//! and the mean rank. Writes `DIR/eval-lights.csv` (one row per map, scene and method) and
+//! and the mean rank; the `emissive-split/...` rows are its Table 2 ablation (masking and k-means
+//! off). Writes `DIR/eval-lights.csv` (one row per map, scene and method) and
 //! `DIR/eval-lights.md`.
 
 use crate::render::load_map;
@@ -32,13 +33,18 @@ struct Row {
     extract_ms: f64,
 }
 
-fn methods(k: usize) -> Vec<Box<dyn LightExtractor>> {
+/// (label, extractor): Table 1's methods, then Table 2's ablation of EmissiveSplit.
+fn methods(k: usize) -> Vec<(String, Box<dyn LightExtractor>)> {
+    let es = EmissiveSplit { lights: k, ..EmissiveSplit::default() };
     vec![
-        Box::new(EmissiveSplit { lights: k, ..EmissiveSplit::default() }),
-        Box::new(CenterSurround { max_lights: k, ..CenterSurround::default() }),
-        Box::new(MedianCut::with_lights(k)),
-        Box::new(VarianceMinimization::with_lights(k)),
-        Box::new(ImportanceSampled { count: k, seed: 0 }),
+        ("emissive-split".into(), Box::new(es)),
+        ("center-surround".into(), Box::new(CenterSurround { max_lights: k, ..CenterSurround::default() })),
+        ("median-cut".into(), Box::new(MedianCut::with_lights(k))),
+        ("variance-min".into(), Box::new(VarianceMinimization::with_lights(k))),
+        ("importance".into(), Box::new(ImportanceSampled { count: k, seed: 0 })),
+        ("emissive-split/no-masking".into(), Box::new(EmissiveSplit { masking: false, ..es })),
+        ("emissive-split/no-kmeans".into(), Box::new(EmissiveSplit { kmeans: false, ..es })),
+        ("emissive-split/neither".into(), Box::new(EmissiveSplit { masking: false, kmeans: false, ..es })),
     ]
 }
 
@@ -68,7 +74,11 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
         let env = EnvLight::new(&map);
         let decompositions: Vec<_> = methods(args.lights)
             .iter()
-            .map(|m| m.extract(&map).map_err(|e| format!("{}: {e}", map_path.display())))
+            .map(|(label, m)| {
+                let mut d = m.extract(&map).map_err(|e| format!("{}: {e}", map_path.display()))?;
+                d.method.clone_from(label);
+                Ok::<_, String>(d)
+            })
             .collect::<Result<_, _>>()?;
         for scene_name in &args.scenes {
             let mut scene = scene::Scene::builtin(scene_name).map_err(|e| e.to_string())?;
