@@ -178,12 +178,17 @@ impl LightExtractor for EmissiveSplit {
         let (w, h) = (map.width(), map.height());
         let row_sa = map.row_solid_angles();
         let dirs = TexelDirections::new(w, h);
-        let stats = map.luminance_stats();
-        // Section 3.2: the emissive threshold.
-        let l_t = f64::from(stats.percentile(self.percentile))
-            .max(self.lambda * stats.mean_per_pixel)
-            .max(self.gamma * f64::from(stats.max));
         let lum: Vec<f64> = map.pixels().iter().map(|p| f64::from(luminance(*p)).max(0.0)).collect();
+        // Section 3.2: the emissive threshold; L_b by selection (nearest rank), not a full sort.
+        let l_b = {
+            let mut v = lum.clone();
+            let rank = ((self.percentile / 100.0) * v.len() as f64).ceil() as usize;
+            let k = rank.clamp(1, v.len()) - 1;
+            *v.select_nth_unstable_by(k, f64::total_cmp).1
+        };
+        let l_avg = lum.iter().sum::<f64>() / lum.len() as f64;
+        let l_max = lum.iter().copied().fold(0.0, f64::max);
+        let l_t = l_b.max(self.lambda * l_avg).max(self.gamma * l_max);
         let mut emissive: Vec<usize> = (0..lum.len()).filter(|&k| lum[k] > l_t && lum[k] > 0.0).collect();
         let sa_of = |k: usize| row_sa[k / w as usize];
         let dir_of = |k: usize| dirs.dir((k % w as usize) as u32, (k / w as usize) as u32).as_dvec3();
