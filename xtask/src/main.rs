@@ -48,44 +48,7 @@ enum Command {
     },
     /// Render a built-in scene with the CPU reference tracer: OUT.exr, a tone-mapped OUT.png,
     /// and with --aovs OUT.albedo.exr, OUT.normal.exr, OUT.depth.exr, OUT.object.exr.
-    Render {
-        /// Built-in scene.
-        #[arg(long)]
-        scene: String,
-        /// Environment map; the embedded default when absent.
-        #[arg(long)]
-        envmap: Option<PathBuf>,
-        /// env-direct (the truth for direct light), lights (extracted lights + ambient) or path.
-        #[arg(long, default_value = "env-direct")]
-        integrator: String,
-        /// lights.json for --integrator lights (an ambient.exr beside it adds SH9 ambient).
-        #[arg(long)]
-        lights: Option<PathBuf>,
-        /// Shadow the ambient term by sampling its visibility.
-        #[arg(long)]
-        shadow_ambient: bool,
-        /// Bounces for --integrator path.
-        #[arg(long, default_value_t = 5)]
-        max_depth: u32,
-        /// Samples per pixel.
-        #[arg(long, default_value_t = 64)]
-        spp: u32,
-        /// Seed: equal seeds give equal images on any number of threads.
-        #[arg(long, default_value_t = 0)]
-        seed: u64,
-        /// Stop after the pass that ends past this many seconds.
-        #[arg(long)]
-        time_budget: Option<f64>,
-        /// Image size WIDTHxHEIGHT instead of the scene's camera.
-        #[arg(long, value_parser = parse_size)]
-        size: Option<(u32, u32)>,
-        /// Output .exr (linear float RGB).
-        #[arg(long)]
-        out: PathBuf,
-        /// Also write the AOVs.
-        #[arg(long)]
-        aovs: bool,
-    },
+    Render(render::RenderArgs),
     /// Decompose a map into shadow-casting lights + ambient: DIR/lights.json, ambient.exr,
     /// lights.gltf (KHR_lights_punctual) and overlay.png.
     Extract {
@@ -147,7 +110,7 @@ enum Command {
     },
 }
 
-fn parse_size(s: &str) -> Result<(u32, u32), String> {
+pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s.split_once('x').ok_or("expected WIDTHxHEIGHT, e.g. 320x240")?;
     Ok((w.parse().map_err(|e| format!("width: {e}"))?, h.parse().map_err(|e| format!("height: {e}"))?))
 }
@@ -159,33 +122,7 @@ fn main() -> ExitCode {
         Command::Test { args } => test::run(&args),
         Command::Info { path, json } => info::run(&path, json),
         Command::Scene { name, obj } => scene::run(&name, &obj),
-        Command::Render {
-            scene,
-            envmap,
-            integrator,
-            lights,
-            shadow_ambient,
-            max_depth,
-            spp,
-            seed,
-            time_budget,
-            size,
-            out,
-            aovs,
-        } => render::run(&render::RenderArgs {
-            scene,
-            envmap,
-            integrator,
-            lights,
-            shadow_ambient,
-            max_depth,
-            spp,
-            seed,
-            time_budget,
-            size,
-            out,
-            aovs,
-        }),
+        Command::Render(args) => render::run(&args),
         Command::Compare { reference, test } => render::compare(&reference, &test),
         Command::EvalLights { maps, scenes, lights, spp, lights_spp, size, out } => {
             eval_lights::run(&eval_lights::EvalArgs {

@@ -1,6 +1,7 @@
 //! `cargo xtask render`: the reference tracer on a built-in scene, with a progress bar and one
 //! summary line; and `cargo xtask compare REF TEST`: RMSE and FLIP.
 
+use crate::parse_size;
 use envmap_sphere::{EnvMap, Sh9, Tonemap};
 use glam::Vec3;
 use ref_tracer::metrics::{FlipTonemap, flip, rmse};
@@ -10,19 +11,44 @@ use serde::Deserialize;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-/// What `render` was asked for.
+/// What `render` was asked for (parsed by clap).
+#[derive(clap::Args)]
 pub struct RenderArgs {
+    /// Built-in scene.
+    #[arg(long)]
     pub scene: String,
+    /// Environment map; the embedded default when absent.
+    #[arg(long)]
     pub envmap: Option<PathBuf>,
+    /// env-direct (the truth for direct light), lights (extracted lights + ambient) or path.
+    #[arg(long, default_value = "env-direct")]
     pub integrator: String,
+    /// lights.json for --integrator lights (an ambient.exr beside it adds SH9 ambient).
+    #[arg(long)]
     pub lights: Option<PathBuf>,
+    /// Shadow the ambient term by sampling its visibility.
+    #[arg(long)]
     pub shadow_ambient: bool,
+    /// Bounces for --integrator path.
+    #[arg(long, default_value_t = 5)]
     pub max_depth: u32,
+    /// Samples per pixel.
+    #[arg(long, default_value_t = 64)]
     pub spp: u32,
+    /// Seed: equal seeds give equal images on any number of threads.
+    #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// Stop after the pass that ends past this many seconds.
+    #[arg(long)]
     pub time_budget: Option<f64>,
+    /// Image size WIDTHxHEIGHT instead of the scene's camera.
+    #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
+    /// Output .exr (linear float RGB).
+    #[arg(long)]
     pub out: PathBuf,
+    /// Also write the AOVs.
+    #[arg(long)]
     pub aovs: bool,
 }
 
