@@ -77,7 +77,12 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
             .map(|(label, m)| {
                 let mut d = m.extract(&map).map_err(|e| format!("{}: {e}", map_path.display()))?;
                 d.method.clone_from(label);
-                Ok::<_, String>(d)
+                // paper 001, section 3.5: 8 sets; the extra 7 as renderers take them
+                let sets: Vec<Vec<scene::DistantLight>> = interleaved_sets(&d.lights, 8, 0.1, 0)[1..]
+                    .iter()
+                    .map(|set| set.iter().map(|l| l.light).collect())
+                    .collect();
+                Ok::<_, String>((d, sets))
             })
             .collect::<Result<_, _>>()?;
         for scene_name in &args.scenes {
@@ -104,15 +109,12 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
                 flip: flip(&reference.color, &floor.color, floor.width, floor.height, &tm),
                 extract_ms: 0.0,
             });
-            for d in &decompositions {
+            for (d, sets) in &decompositions {
                 let lights = d.distant_lights();
-                let sets: Vec<Vec<scene::DistantLight>> = interleaved_sets(&d.lights, 8, 0.1, 0)[1..]
-                    .iter()
-                    .map(|s| s.iter().map(|l| l.light).collect())
-                    .collect();
+
                 let set = LightSet {
                     lights: &lights,
-                    interleaved: &sets,
+                    interleaved: sets,
                     ambient: Some(d.ambient_sh),
                     shadow_ambient: false,
                     background: Some(&map),
@@ -139,7 +141,6 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
 /// Mean of `value` per method, the ratio of means to median cut's, and the mean rank.
 fn summary(rows: &[Row], value: impl Fn(&Row) -> f64) -> Vec<(String, f64, f64)> {
     let mut names: Vec<String> = rows.iter().map(|r| r.method.clone()).collect();
-    names.dedup();
     names.sort();
     names.dedup();
     let cases: Vec<(String, String)> = {

@@ -4,6 +4,8 @@
 
 use crate::color::luminance;
 use crate::envmap::EnvMap;
+use crate::latlong::latlong_row_factors;
+#[cfg(test)]
 use crate::latlong::latlong_texel_vector;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -92,16 +94,8 @@ struct TexelVectors {
 
 impl TexelVectors {
     fn new(width: u32, height: u32) -> Self {
-        // Factor latlong_texel_vector: x = s2 * cx, y = cs * dphi, z = -s2 * sz.
-        let rows = (0..height)
-            .map(|j| {
-                let [x, _, _] = latlong_texel_vector(0, j, width, height);
-                let phi1 = 2.0 * std::f64::consts::PI / f64::from(width);
-                let s2 = x / (1.0 - phi1.cos());
-                let [_, y, _] = latlong_texel_vector(0, j, width, height);
-                (s2, y / phi1)
-            })
-            .collect();
+        // latlong_texel_vector factored: x = s2 * cx, y = cs * dphi, z = -s2 * sz.
+        let rows = (0..height).map(|j| latlong_row_factors(j, height)).collect();
         let cols = (0..width)
             .map(|i| {
                 let w = f64::from(width);

@@ -68,14 +68,20 @@ pub fn row_cos_bounds(j: u32, height: u32) -> (f64, f64) {
 /// cos over it, which makes brute-force irradiance exact away from the horizon.
 #[must_use]
 pub fn latlong_texel_vector(i: u32, j: u32, width: u32, height: u32) -> [f64; 3] {
-    let (w, h) = (f64::from(width), f64::from(height));
+    let w = f64::from(width);
     let (p0, p1) = (2.0 * PI64 * f64::from(i) / w, 2.0 * PI64 * f64::from(i + 1) / w);
-    let (t0, t1) = (PI64 * f64::from(j) / h, PI64 * f64::from(j + 1) / h);
-    // integral of sin^2 theta d theta, and of cos theta sin theta d theta
-    let a = |t: f64| (t - t.sin() * t.cos()) * 0.5;
-    let sin2_theta = a(t1) - a(t0);
-    let cos_sin_theta = 0.5 * (t1.sin().powi(2) - t0.sin().powi(2));
+    let (sin2_theta, cos_sin_theta) = latlong_row_factors(j, height);
     [sin2_theta * (p0.cos() - p1.cos()), cos_sin_theta * (p1 - p0), -sin2_theta * (p1.sin() - p0.sin())]
+}
+
+/// The row part of [`latlong_texel_vector`] for row `j`: the integrals over the row's theta
+/// range of sin^2 theta and of cos theta sin theta.
+#[must_use]
+pub fn latlong_row_factors(j: u32, height: u32) -> (f64, f64) {
+    let h = f64::from(height);
+    let (t0, t1) = (PI64 * f64::from(j) / h, PI64 * f64::from(j + 1) / h);
+    let a = |t: f64| (t - t.sin() * t.cos()) * 0.5;
+    (a(t1) - a(t0), 0.5 * (t1.sin().powi(2) - t0.sin().powi(2)))
 }
 
 /// Texel-centre directions of a `width` x `height` map without per-texel trigonometry: the

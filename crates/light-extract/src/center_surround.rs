@@ -232,7 +232,6 @@ impl CenterSurround {
 
 /// One pyramid level: its map, cap sums and candidate centres.
 struct Level {
-    map: EnvMap,
     sums: CapSums,
     /// candidate texel centres (theta, phi), fixed at the first iteration
     candidates: Vec<(f64, f64)>,
@@ -260,31 +259,40 @@ impl CenterSurround {
         (self.inner_weight * inner + self.ring_weight * (outer - inner)) / (2.0 * ro)
     }
 
-    /// Builds the levels of `map` for `plan` (candidates: each level's brightest fraction).
-    fn levels(&self, map: &EnvMap, plan: &[(u32, Vec<f64>)]) -> Vec<Level> {
+    /// The pyramid of `map` for `plan`: one downsampled map per level.
+    fn pyramid(map: &EnvMap, plan: &[(u32, Vec<f64>)]) -> Vec<EnvMap> {
         let mut out = Vec::with_capacity(plan.len());
-        let mut current = map.clone();
-        let mut at = 0;
+        let (mut current, mut at) = (map.clone(), 0);
         for (level, _) in plan {
             while at < *level {
                 current = current.resize(current.width() / 2, current.height() / 2);
                 at += 1;
             }
-            let (w, h) = (current.width() as usize, current.height() as usize);
-            let lum: Vec<f32> = current.pixels().iter().map(|p| luminance(*p)).collect();
-            let n = ((lum.len() as f64 * self.candidate_fraction).ceil() as usize).clamp(1, lum.len());
-            let mut sorted = lum.clone();
-            sorted.select_nth_unstable_by(lum.len() - n, f32::total_cmp);
-            let threshold = sorted[lum.len() - n].max(f32::MIN_POSITIVE);
-            let candidates = lum
-                .iter()
-                .enumerate()
-                .filter(|(_, y)| **y >= threshold)
-                .map(|(k, _)| angles(k % w, k / w, w, h))
-                .collect();
-            out.push(Level { sums: CapSums::new(&current), map: current.clone(), candidates });
+            out.push(current.clone());
         }
         out
+    }
+
+    /// The levels of `map` for `plan`; candidates: each level's brightest fraction of texels.
+    fn levels(&self, map: &EnvMap, plan: &[(u32, Vec<f64>)]) -> Vec<Level> {
+        Self::pyramid(map, plan)
+            .into_iter()
+            .map(|current| {
+                let (w, h) = (current.width() as usize, current.height() as usize);
+                let lum: Vec<f32> = current.pixels().iter().map(|p| luminance(*p)).collect();
+                let n = ((lum.len() as f64 * self.candidate_fraction).ceil() as usize).clamp(1, lum.len());
+                let mut sorted = lum.clone();
+                sorted.select_nth_unstable_by(lum.len() - n, f32::total_cmp);
+                let threshold = sorted[lum.len() - n].max(f32::MIN_POSITIVE);
+                let candidates = lum
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, y)| **y >= threshold)
+                    .map(|(k, _)| angles(k % w, k / w, w, h))
+                    .collect();
+                Level { sums: CapSums::new(&current), candidates }
+            })
+            .collect()
     }
 }
 
@@ -332,14 +340,11 @@ impl LightExtractor for CenterSurround {
                 remainder.set_pixel(i, j, Vec3::ZERO);
             }
             // Only filters overlapping the removed cap change: refresh those, on updated levels.
-            let fresh = self.levels(&remainder, &plan);
-            for (level, new) in levels.iter_mut().zip(fresh) {
-                level.map = new.map;
-                level.sums = new.sums;
+            for (level, map) in levels.iter_mut().zip(Self::pyramid(&remainder, &plan)) {
+                level.sums = CapSums::new(&map);
             }
             for r in responses.iter_mut() {
-                if angle_between((r.theta, r.phi), (theta, phi))
-                    <= r.ro + ri + 2.0 * PI / f64::from(levels[r.level].map.height())
+                if angle_between((r.theta, r.phi), (theta, phi)) <= r.ro + ri + 2.0 * PI / levels[r.level].sums.h as f64
                 {
                     r.value = self.response(&levels[r.level].sums, r.theta, r.phi, r.ro);
                 }

@@ -133,7 +133,7 @@ impl Integrator<'_> {
                 let env = env.expect("EnvDirect needs the map");
                 match bvh.intersect(origin, dir, f32::INFINITY) {
                     None => env.map.lookup(dir),
-                    Some(sp) => env_direct(bvh, env, &Shading::new(bvh, &sp, dir), *strategy, s).0,
+                    Some(sp) => env_direct(bvh, env, &Shading::new(bvh, &sp, dir), *strategy, false, s).0,
                 }
             }
             Self::Lights(set) => match bvh.intersect(origin, dir, f32::INFINITY) {
@@ -145,15 +145,27 @@ impl Integrator<'_> {
     }
 }
 
-/// One MIS estimate of direct light from the map; also returns the BRDF-sampled continuation
-/// (direction, f cos / pdf, pdf, whether it escaped) for path tracing to reuse.
+/// The BRDF-sampled continuation of an `env_direct` estimate.
+struct Continuation {
+    /// World direction.
+    dir: Vec3,
+    /// f cos / pdf.
+    weight: Vec3,
+    /// What the ray hits (`None`: it escaped, and its light was counted), when asked for.
+    hit: Option<SurfacePoint>,
+}
+
+/// One MIS estimate of direct light from the map. With `trace_brdf_ray`, the BRDF sample's ray
+/// is traced to its closest hit and returned for path tracing to continue from, so the ray is
+/// traversed once; without, an any-hit occlusion test decides its visibility.
 fn env_direct(
     bvh: &SceneBvh,
     env: &EnvLight,
     sh: &Shading,
     strategy: Strategy,
+    trace_brdf_ray: bool,
     s: &mut PixelSampler,
-) -> (Vec3, Option<(Vec3, Vec3, f32)>) {
+) -> (Vec3, Option<Continuation>) {
     let mut l = Vec3::ZERO;
     let u_env = s.next_2d();
     let (u_brdf, u_lobe) = (s.next_2d(), s.next_1d());
@@ -171,12 +183,15 @@ fn env_direct(
         let wi_world = sh.frame.to_world(wi);
         let (fc, _) = sh.f_cos(wi_world);
         if fc != Vec3::ZERO {
-            next = Some((wi_world, fc / pdf, pdf));
-            if strategy != Strategy::EnvOnly && !bvh.occluded(sh.origin(), wi_world, f32::INFINITY) {
+            let hit = if trace_brdf_ray { bvh.intersect(sh.origin(), wi_world, f32::INFINITY) } else { None };
+            let escaped =
+                if trace_brdf_ray { hit.is_none() } else { !bvh.occluded(sh.origin(), wi_world, f32::INFINITY) };
+            if strategy != Strategy::EnvOnly && escaped {
                 let uv = envmap_sphere::latlong::latlong_dir_to_uv(wi_world);
                 let w = if strategy == Strategy::Mis { power_heuristic(pdf, env.dist.uv_pdf(uv)) } else { 1.0 };
                 l += fc * env.map.lookup_uv(uv) * (w / pdf);
             }
+            next = Some(Continuation { dir: wi_world, weight: fc / pdf, hit });
         }
     }
     (l, next)
@@ -214,20 +229,15 @@ fn lights_direct(bvh: &SceneBvh, set: &LightSet, sh: &Shading, s: &mut PixelSamp
 
 fn path(bvh: &SceneBvh, env: &EnvLight, origin: Vec3, dir: Vec3, max_depth: u32, s: &mut PixelSampler) -> Vec3 {
     let (mut l, mut beta) = (Vec3::ZERO, Vec3::ONE);
-    let (mut o, mut d) = (origin, dir);
+    let Some(mut sp) = bvh.intersect(origin, dir, f32::INFINITY) else { return env.map.lookup(dir) };
+    let mut d = dir;
     for depth in 0..max_depth {
-        let Some(sp) = bvh.intersect(o, d, f32::INFINITY) else {
-            if depth == 0 {
-                l += env.map.lookup(d);
-            }
-            break;
-        };
         let sh = Shading::new(bvh, &sp, d);
-        // NEE with MIS; the BRDF-sampled escape is counted inside env_direct, so the path
-        // continues only through hits.
-        let (direct, next) = env_direct(bvh, env, &sh, Strategy::Mis, s);
+        // NEE with MIS; a BRDF ray that escapes is counted inside env_direct, so the path
+        // continues only through its hit.
+        let (direct, next) = env_direct(bvh, env, &sh, Strategy::Mis, depth + 1 < max_depth, s);
         l += beta * direct;
-        let Some((wi, weight, _)) = next else { break };
+        let Some(Continuation { dir: wi, weight, hit: Some(hit) }) = next else { break };
         beta *= weight;
         if depth >= 3 {
             // Russian roulette
@@ -237,8 +247,7 @@ fn path(bvh: &SceneBvh, env: &EnvLight, origin: Vec3, dir: Vec3, max_depth: u32,
             }
             beta /= q;
         }
-        o = sh.origin();
-        d = wi;
+        (sp, d) = (hit, wi);
     }
     l
 }
