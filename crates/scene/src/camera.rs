@@ -60,13 +60,14 @@ impl Camera {
 /// Precomputed ray generation of a [`Camera`].
 #[derive(Clone, Copy, Debug)]
 pub struct CameraRays {
-    eye: Vec3,
+    /// ray origin
+    pub eye: Vec3,
     /// image-plane step per pixel to the right
-    right: Vec3,
+    pub right: Vec3,
     /// image-plane step per pixel down
-    down: Vec3,
+    pub down: Vec3,
     /// image-plane point of pixel coordinate (0, 0), the top-left corner
-    corner: Vec3,
+    pub corner: Vec3,
 }
 
 impl CameraRays {

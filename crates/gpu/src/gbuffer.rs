@@ -1,0 +1,182 @@
+//! The G-buffer: per pixel, the visible surface's world position and object, shading normal and
+//! geometric normal. Shadow techniques read it to write visibility; the shading pass to light.
+
+use crate::context::{Gpu, GpuError};
+use crate::geometry::SceneGeometry;
+use glam::{Mat4, Vec3};
+use wgpu::util::DeviceExt;
+
+/// Format of the G-buffer's colour targets.
+pub const GBUFFER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+
+/// The G-buffer of one view.
+pub struct GBuffer {
+    /// xyz world position, w object index (or -1 where camera rays miss).
+    pub position: wgpu::Texture,
+    /// xyz shading normal facing the camera.
+    pub normal: wgpu::Texture,
+    /// xyz geometric normal facing the camera.
+    pub geometric_normal: wgpu::Texture,
+    /// Depth (Depth32Float).
+    pub depth: wgpu::Texture,
+    /// The camera it was rendered with.
+    pub camera: scene::Camera,
+}
+
+/// Projection × view of `camera` for wgpu's clip space (depth in [0, 1]); `near`/`far` in metres.
+#[must_use]
+pub fn view_projection(camera: &scene::Camera, near: f32, far: f32) -> Mat4 {
+    let aspect = camera.width as f32 / camera.height as f32;
+    let tan_half_x = (camera.hfov_degrees.to_radians() * 0.5).tan();
+    let fov_y = 2.0 * (tan_half_x / aspect).atan();
+    let (_, up, forward) = camera.basis();
+    glam::camera::rh::proj::directx::perspective(fov_y, aspect, near, far)
+        * glam::camera::rh::view::look_to_mat4(camera.eye, forward, up)
+}
+
+fn target(gpu: &Gpu, camera: &scene::Camera, label: &str, format: wgpu::TextureFormat) -> wgpu::Texture {
+    gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width: camera.width, height: camera.height, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    })
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct CameraUniform {
+    view_proj: [[f32; 4]; 4],
+    eye: [f32; 4],
+}
+
+impl GBuffer {
+    /// Renders the G-buffer of `geometry` seen by `camera`.
+    ///
+    /// # Errors
+    /// [`GpuError::TooLarge`] for an image beyond the adapter's limits; GPU failures.
+    pub fn render(gpu: &Gpu, geometry: &SceneGeometry, camera: &scene::Camera) -> Result<Self, GpuError> {
+        gpu.check_texture(camera.width, camera.height, 1)?;
+        let gb = Self {
+            position: target(gpu, camera, "gbuffer position", GBUFFER_FORMAT),
+            normal: target(gpu, camera, "gbuffer normal", GBUFFER_FORMAT),
+            geometric_normal: target(gpu, camera, "gbuffer geometric normal", GBUFFER_FORMAT),
+            depth: target(gpu, camera, "gbuffer depth", wgpu::TextureFormat::Depth32Float),
+            camera: *camera,
+        };
+        // Near and far planes bracket the scene's bounds as seen from the eye.
+        let (lo, hi) = geometry.bounds;
+        let reach = if lo.is_finite() { (hi - lo).length() + camera.eye.distance(0.5 * (lo + hi)) } else { 1.0 };
+        let far = reach.max(1e-3) * 1.01;
+        let near = (far * 1e-5).max(1e-4);
+        let uniform = CameraUniform {
+            view_proj: view_projection(camera, near, far).to_cols_array_2d(),
+            eye: Vec3::extend(camera.eye, 1.0).to_array(),
+        };
+        let buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("camera"),
+            contents: bytemuck::bytes_of(&uniform),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let module =
+            crate::shader::module(&gpu.device, "gbuffer", include_str!("../../../shaders/gpu/gbuffer.wgsl"), &[]);
+        let targets: [Option<wgpu::ColorTargetState>; 3] = std::array::from_fn(|_| Some(GBUFFER_FORMAT.into()));
+        let pipeline = gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("gbuffer"),
+            layout: None,
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs"),
+                compilation_options: Default::default(),
+                buffers: &[Some(SceneGeometry::LAYOUT)],
+            },
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: wgpu::TextureFormat::Depth32Float,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs"),
+                compilation_options: Default::default(),
+                targets: &targets,
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("gbuffer"),
+            layout: &pipeline.get_bind_group_layout(0),
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }],
+        });
+        let views = [&gb.position, &gb.normal, &gb.geometric_normal].map(|t| t.create_view(&Default::default()));
+        let clear =
+            [wgpu::Color { r: 0.0, g: 0.0, b: 0.0, a: -1.0 }, wgpu::Color::TRANSPARENT, wgpu::Color::TRANSPARENT];
+        let attachments: Vec<_> = views
+            .iter()
+            .zip(clear)
+            .map(|(view, c)| {
+                Some(wgpu::RenderPassColorAttachment {
+                    view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations { load: wgpu::LoadOp::Clear(c), store: wgpu::StoreOp::Store },
+                })
+            })
+            .collect();
+        let depth_view = gb.depth.create_view(&Default::default());
+        let mut encoder = gpu.encoder("gbuffer");
+        {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("gbuffer"),
+                color_attachments: &attachments,
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &depth_view,
+                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&pipeline);
+            pass.set_bind_group(0, &bind, &[]);
+            pass.set_vertex_buffer(0, geometry.vertices.slice(..));
+            pass.draw(0..geometry.vertex_count, 0..1);
+        }
+        gpu.submit_and_wait(encoder)?;
+        Ok(gb)
+    }
+
+    /// Image size.
+    #[must_use]
+    pub fn size(&self) -> (u32, u32) {
+        (self.camera.width, self.camera.height)
+    }
+
+    /// Reads the positions back: xyz and object index (-1 for background), row-major.
+    ///
+    /// # Errors
+    /// GPU failures.
+    pub fn read_positions(&self, gpu: &Gpu) -> Result<Vec<[f32; 4]>, GpuError> {
+        crate::readback::read_texture_rgba(gpu, &self.position, 0)
+    }
+
+    /// Reads the geometric normals back, row-major.
+    ///
+    /// # Errors
+    /// GPU failures.
+    pub fn read_geometric_normals(&self, gpu: &Gpu) -> Result<Vec<[f32; 4]>, GpuError> {
+        crate::readback::read_texture_rgba(gpu, &self.geometric_normal, 0)
+    }
+}

@@ -1,0 +1,27 @@
+//! The shared GPU layer: a wgpu device (on machines without a GPU, Mesa's lavapipe on Vulkan),
+//! offscreen targets and readback, GPU timestamps, WGSL composition, and the raster renderer
+//! that mirrors `scene`'s BRDF: a G-buffer pass and a shading pass lit by distant cone lights,
+//! point lights and SH9 ambient, each light's shadow given as a screen-space visibility layer.
+//!
+//! Shadow techniques (`shadowmap-paraboloid`, later `penumbra-wedge`) fill those layers from the
+//! G-buffer; the shading pass does not know how a layer was made.
+//!
+//! ```no_run
+//! let gpu = gpu::Gpu::new().expect("a Vulkan adapter (lavapipe: mesa-vulkan-drivers)");
+//! println!("{}", gpu.describe());
+//! ```
+
+mod context;
+mod gbuffer;
+mod geometry;
+mod readback;
+mod shade;
+pub mod shader;
+mod timer;
+
+pub use context::{Gpu, GpuError};
+pub use gbuffer::{GBUFFER_FORMAT, GBuffer, view_projection};
+pub use geometry::{Chunk, SceneGeometry, ShadowGeometry, scene_triangles};
+pub use readback::{read_texture_f32, read_texture_rgba};
+pub use shade::{HDR_FORMAT, ShadeLight, ShadeParams, ShadingPass, Visibility};
+pub use timer::Clock;

@@ -1,0 +1,85 @@
+//! Reading textures and buffers back to the CPU (rows padded to 256 bytes by the copy rules).
+
+use crate::context::{Gpu, GpuError};
+
+/// Maps `buffer` (MAP_READ) and returns its bytes.
+pub(crate) fn map_read(gpu: &Gpu, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
+    let (tx, rx) = std::sync::mpsc::channel();
+    buffer.map_async(wgpu::MapMode::Read, .., move |r| {
+        let _ = tx.send(r);
+    });
+    gpu.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Failed(e.to_string()))?;
+    rx.recv()
+        .map_err(|e| GpuError::Failed(e.to_string()))?
+        .map_err(|e| GpuError::Failed(format!("mapping a readback buffer: {e}")))?;
+    let bytes = buffer.get_mapped_range(..).map_err(|e| GpuError::Failed(e.to_string()))?.to_vec();
+    buffer.unmap();
+    Ok(bytes)
+}
+
+/// Copies one layer of a texture with 4-byte texels per channel group into tightly packed
+/// bytes, row by row.
+fn read_layer_bytes(
+    gpu: &Gpu,
+    texture: &wgpu::Texture,
+    layer: u32,
+    aspect: wgpu::TextureAspect,
+) -> Result<Vec<u8>, GpuError> {
+    let (w, h) = (texture.width(), texture.height());
+    let bpp = texture
+        .format()
+        .block_copy_size(Some(aspect))
+        .ok_or_else(|| GpuError::Failed(format!("cannot read back {:?}", texture.format())))?;
+    let row = w * bpp;
+    let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size: u64::from(padded) * u64::from(h),
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut encoder = gpu.encoder("readback");
+    encoder.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo { texture, mip_level: 0, origin: wgpu::Origin3d { x: 0, y: 0, z: layer }, aspect },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(padded), rows_per_image: Some(h) },
+        },
+        wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+    );
+    gpu.submit_and_wait(encoder)?;
+    let bytes = map_read(gpu, &buffer)?;
+    Ok(bytes.chunks_exact(padded as usize).flat_map(|r| r[..row as usize].to_vec()).collect())
+}
+
+/// Reads one layer of a single-channel 32-bit float texture (R32Float, or the depth aspect of
+/// Depth32Float / Depth32FloatStencil8), row-major from the top-left.
+///
+/// # Errors
+/// [`GpuError::Failed`] when the format cannot be read back or the copy fails.
+pub fn read_texture_f32(gpu: &Gpu, texture: &wgpu::Texture, layer: u32) -> Result<Vec<f32>, GpuError> {
+    let aspect = if texture.format().is_depth_stencil_format() {
+        wgpu::TextureAspect::DepthOnly
+    } else {
+        wgpu::TextureAspect::All
+    };
+    let bytes = read_layer_bytes(gpu, texture, layer, aspect)?;
+    Ok(bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect())
+}
+
+/// Reads one layer of an Rgba32Float texture as RGBA quadruples, row-major from the top-left;
+/// an R8Unorm texture comes back as one float per texel in [0, 1].
+///
+/// # Errors
+/// As [`read_texture_f32`].
+pub fn read_texture_rgba(gpu: &Gpu, texture: &wgpu::Texture, layer: u32) -> Result<Vec<[f32; 4]>, GpuError> {
+    let bytes = read_layer_bytes(gpu, texture, layer, wgpu::TextureAspect::All)?;
+    match texture.format() {
+        wgpu::TextureFormat::Rgba32Float => Ok(bytes
+            .chunks_exact(16)
+            .map(|b| std::array::from_fn(|c| f32::from_le_bytes([b[4 * c], b[4 * c + 1], b[4 * c + 2], b[4 * c + 3]])))
+            .collect()),
+        wgpu::TextureFormat::R8Unorm => Ok(bytes.iter().map(|&b| [f32::from(b) / 255.0, 0.0, 0.0, 0.0]).collect()),
+        f => Err(GpuError::Failed(format!("read_texture_rgba: unsupported format {f:?}"))),
+    }
+}

@@ -1,0 +1,330 @@
+//! The shading pass and the visibility layers it reads: one R8Unorm layer per light, written by
+//! a shadow technique (or left at 1 for unshadowed light).
+
+use crate::context::{Gpu, GpuError};
+use crate::gbuffer::GBuffer;
+use crate::geometry::SceneGeometry;
+use envmap_sphere::{EnvMap, Sh9};
+use glam::Vec3;
+use wgpu::util::DeviceExt;
+
+/// A light as the shading pass sees it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ShadeLight {
+    /// A distant light, shaded as directional: its cone's irradiance from its centre direction.
+    Distant {
+        /// Unit direction towards the light.
+        direction: Vec3,
+        /// Irradiance at normal incidence: radiance × solid angle.
+        irradiance: Vec3,
+    },
+    /// A point light.
+    Point {
+        /// Position in metres.
+        position: Vec3,
+        /// Intensity, W/sr.
+        intensity: Vec3,
+    },
+}
+
+impl From<&scene::DistantLight> for ShadeLight {
+    fn from(l: &scene::DistantLight) -> Self {
+        ShadeLight::Distant { direction: l.direction, irradiance: l.radiance * l.solid_angle }
+    }
+}
+
+impl From<&scene::PointLight> for ShadeLight {
+    fn from(l: &scene::PointLight) -> Self {
+        ShadeLight::Point { position: l.position, intensity: l.intensity }
+    }
+}
+
+/// What lights a frame.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ShadeParams<'a> {
+    /// The lights, in the order of the visibility layers.
+    pub lights: &'a [ShadeLight],
+    /// Ambient radiance as SH9 (its irradiance lights the diffuse lobe, unshadowed).
+    pub ambient: Option<&'a Sh9>,
+    /// What misses see; black without.
+    pub background: Option<&'a EnvMap>,
+}
+
+/// One visibility layer per light, screen-sized, 1 = lit.
+pub struct Visibility {
+    /// R8Unorm 2D array.
+    pub texture: wgpu::Texture,
+}
+
+impl Visibility {
+    /// Format of the layers.
+    pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
+
+    /// `layers` layers of `width` × `height`, all lit (1).
+    ///
+    /// # Errors
+    /// [`GpuError::TooLarge`] beyond the adapter's limits.
+    pub fn new(gpu: &Gpu, width: u32, height: u32, layers: u32) -> Result<Self, GpuError> {
+        let layers = layers.max(1);
+        gpu.check_texture(width, height, layers)?;
+        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("visibility"),
+            size: wgpu::Extent3d { width, height, depth_or_array_layers: layers },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: Self::FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let mut encoder = gpu.encoder("visibility clear");
+        for layer in 0..layers {
+            let view = Self::view_of(&texture, layer);
+            encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("visibility clear"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::WHITE),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                ..Default::default()
+            });
+        }
+        gpu.submit_and_wait(encoder)?;
+        Ok(Self { texture })
+    }
+
+    fn view_of(texture: &wgpu::Texture, layer: u32) -> wgpu::TextureView {
+        texture.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2),
+            base_array_layer: layer,
+            array_layer_count: Some(1),
+            ..Default::default()
+        })
+    }
+
+    /// A render-target view of one layer (for a shadow technique to write).
+    #[must_use]
+    pub fn layer(&self, layer: u32) -> wgpu::TextureView {
+        Self::view_of(&self.texture, layer)
+    }
+
+    /// Number of layers.
+    #[must_use]
+    pub fn layers(&self) -> u32 {
+        self.texture.depth_or_array_layers()
+    }
+
+    /// Reads one layer back, row-major, values in [0, 1].
+    ///
+    /// # Errors
+    /// GPU failures.
+    pub fn read(&self, gpu: &Gpu, layer: u32) -> Result<Vec<f32>, GpuError> {
+        Ok(crate::readback::read_texture_rgba(gpu, &self.texture, layer)?.into_iter().map(|v| v[0]).collect())
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct LightUniform {
+    position_or_direction: [f32; 4],
+    value: [f32; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct ShadeUniform {
+    eye: [f32; 4],
+    right: [f32; 4],
+    down: [f32; 4],
+    corner: [f32; 4],
+    counts: [u32; 4],
+    sh: [[f32; 4]; 9],
+}
+
+/// The shading pass: pipeline built once, run per frame.
+pub struct ShadingPass {
+    pipeline: wgpu::RenderPipeline,
+}
+
+/// Output format of the shading pass: linear HDR radiance.
+pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+
+impl ShadingPass {
+    /// Builds the pipeline.
+    #[must_use]
+    pub fn new(gpu: &Gpu) -> Self {
+        let module = crate::shader::module(&gpu.device, "shade", include_str!("../../../shaders/gpu/shade.wgsl"), &[]);
+        let pipeline = gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("shade"),
+            layout: None,
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: None,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs"),
+                compilation_options: Default::default(),
+                targets: &[Some(HDR_FORMAT.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        Self { pipeline }
+    }
+
+    /// Shades `gbuffer` and returns the linear HDR image, row-major from the top-left.
+    ///
+    /// # Errors
+    /// [`GpuError::TooLarge`] when `visibility` has fewer layers than lights or the map is too
+    /// large; GPU failures.
+    pub fn render(
+        &self,
+        gpu: &Gpu,
+        geometry: &SceneGeometry,
+        gbuffer: &GBuffer,
+        params: &ShadeParams,
+        visibility: &Visibility,
+    ) -> Result<Vec<Vec3>, GpuError> {
+        let (w, h) = gbuffer.size();
+        if (params.lights.len() as u32) > visibility.layers() {
+            return Err(GpuError::TooLarge {
+                what: "lights for the visibility layers",
+                size: params.lights.len() as u64,
+                limit: visibility.layers().into(),
+            });
+        }
+        let output = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("shaded"),
+            size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: HDR_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let background = upload_background(gpu, params.background)?;
+        let rays = gbuffer.camera.rays();
+        let mut sh = [[0.0f32; 4]; 9];
+        if let Some(ambient) = params.ambient {
+            const BAND: [usize; 9] = [0, 1, 1, 1, 2, 2, 2, 2, 2];
+            for (k, c) in ambient.coeffs.iter().enumerate() {
+                sh[k] = (*c * envmap_sphere::sh::IRRADIANCE_BAND_FACTORS[BAND[k]]).extend(0.0).to_array();
+            }
+        }
+        let (bw, bh) = params.background.map_or((0, 0), |m| (m.width(), m.height()));
+        let uniform = ShadeUniform {
+            eye: rays.eye.extend(1.0).to_array(),
+            right: rays.right.extend(0.0).to_array(),
+            down: rays.down.extend(0.0).to_array(),
+            corner: rays.corner.extend(0.0).to_array(),
+            counts: [params.lights.len() as u32, u32::from(params.ambient.is_some()), bw, bh],
+            sh,
+        };
+        let mut lights: Vec<LightUniform> = params
+            .lights
+            .iter()
+            .map(|l| match *l {
+                ShadeLight::Distant { direction, irradiance } => LightUniform {
+                    position_or_direction: direction.normalize_or_zero().extend(0.0).to_array(),
+                    value: irradiance.extend(0.0).to_array(),
+                },
+                ShadeLight::Point { position, intensity } => LightUniform {
+                    position_or_direction: position.extend(1.0).to_array(),
+                    value: intensity.extend(0.0).to_array(),
+                },
+            })
+            .collect();
+        if lights.is_empty() {
+            lights.push(bytemuck::Zeroable::zeroed());
+        }
+        let uniform_buf = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("shade params"),
+            contents: bytemuck::bytes_of(&uniform),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let light_buf = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("lights"),
+            contents: bytemuck::cast_slice(&lights),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let views = [&gbuffer.position, &gbuffer.normal, &gbuffer.geometric_normal, &background]
+            .map(|t| t.create_view(&Default::default()));
+        let vis_view = visibility.texture.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("shade"),
+            layout: &self.pipeline.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: uniform_buf.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: light_buf.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: geometry.materials.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&views[0]) },
+                wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&views[1]) },
+                wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&views[2]) },
+                wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::TextureView(&vis_view) },
+                wgpu::BindGroupEntry { binding: 7, resource: wgpu::BindingResource::TextureView(&views[3]) },
+            ],
+        });
+        let out_view = output.create_view(&Default::default());
+        let mut encoder = gpu.encoder("shade");
+        {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("shade"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &out_view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                ..Default::default()
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &bind, &[]);
+            pass.draw(0..3, 0..1);
+        }
+        gpu.submit_and_wait(encoder)?;
+        let rgba = crate::readback::read_texture_rgba(gpu, &output, 0)?;
+        Ok(rgba.into_iter().map(|v| Vec3::new(v[0], v[1], v[2])).collect())
+    }
+}
+
+fn upload_background(gpu: &Gpu, map: Option<&EnvMap>) -> Result<wgpu::Texture, GpuError> {
+    let (w, h) = map.map_or((1, 1), |m| (m.width(), m.height()));
+    gpu.check_texture(w, h, 1)?;
+    let texels: Vec<[f32; 4]> =
+        map.map_or_else(|| vec![[0.0; 4]], |m| m.pixels().iter().map(|p| p.extend(1.0).to_array()).collect());
+    Ok(gpu.device.create_texture_with_data(
+        &gpu.queue,
+        &wgpu::TextureDescriptor {
+            label: Some("background"),
+            size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        bytemuck::cast_slice(&texels),
+    ))
+}

@@ -1,0 +1,164 @@
+//! The raster renderer against independent results: `ref-tracer`'s `lights` integrator on a
+//! scene without cast shadows (same BRDF, SH9 ambient and background), and the closed form of a
+//! point light over a Lambertian plane. Runs on lavapipe where there is no GPU.
+
+use envmap_sphere::{EnvMap, Sh9};
+use glam::Vec3;
+use gpu::{GBuffer, Gpu, SceneGeometry, ShadeLight, ShadeParams, ShadingPass, Visibility};
+use ref_tracer::{EnvLight, Integrator, LightSet, RenderSettings, SceneBvh, render};
+use scene::{Camera, DistantLight, Ggx, Material, Mesh, Object, PointLight, Scene};
+
+fn gpu() -> Gpu {
+    Gpu::new().unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn camera(eye: Vec3, target: Vec3, w: u32, h: u32) -> Camera {
+    Camera { eye, target, up: Vec3::Y, hfov_degrees: 50.0, width: w, height: h }
+}
+
+fn gpu_render(gpu: &Gpu, scene: &Scene, params: &ShadeParams) -> (Vec<Vec3>, Vec<[f32; 4]>) {
+    let geometry = SceneGeometry::upload(gpu, scene).unwrap();
+    let gb = GBuffer::render(gpu, &geometry, &scene.camera).unwrap();
+    let vis = Visibility::new(gpu, scene.camera.width, scene.camera.height, params.lights.len() as u32).unwrap();
+    let image = ShadingPass::new(gpu).render(gpu, &geometry, &gb, params, &vis).unwrap();
+    (image, gb.read_positions(gpu).unwrap())
+}
+
+/// Pixels whose 3x3 neighbourhood sees one object and one face orientation in both renders: no
+/// silhouette or box edge inside.
+fn interior(ids: &[u32], normals: &[Vec3], gpu_pos: &[[f32; 4]], w: usize, h: usize) -> Vec<usize> {
+    (0..w * h)
+        .filter(|&k| {
+            let (x, y) = ((k % w) as i64, (k / w) as i64);
+            let id = ids[k];
+            (-1..=1).all(|dy| {
+                (-1..=1).all(|dx| {
+                    let (nx, ny) = (x + dx, y + dy);
+                    if nx < 0 || ny < 0 || nx >= w as i64 || ny >= h as i64 {
+                        return false;
+                    }
+                    let j = (ny as usize) * w + nx as usize;
+                    let gpu_id = gpu_pos[j][3];
+                    ids[j] == id
+                        && (id == u32::MAX || normals[j].dot(normals[k]) > 0.99)
+                        && (if id == u32::MAX { gpu_id < 0.0 } else { gpu_id == id as f32 })
+                })
+            })
+        })
+        .collect()
+}
+
+#[test]
+fn shading_matches_ref_tracer_lights_without_shadows() {
+    let gpu = gpu();
+    let glossy =
+        Material { albedo: Vec3::new(0.7, 0.5, 0.3), specular: Some(Ggx { roughness: 0.4, f0: Vec3::splat(0.04) }) };
+    let metal =
+        Material { albedo: Vec3::splat(0.2), specular: Some(Ggx { roughness: 0.55, f0: Vec3::new(0.9, 0.6, 0.3) }) };
+    let scene = Scene {
+        name: "apart".into(),
+        objects: vec![
+            Object {
+                name: "sphere".into(),
+                mesh: Mesh::icosphere(Vec3::new(-2.0, 0.0, 0.0), 1.0, 4),
+                material: glossy,
+            },
+            Object {
+                name: "box".into(),
+                mesh: Mesh::cuboid(Vec3::new(1.5, -0.5, -0.5), Vec3::new(2.5, 0.5, 0.5)),
+                material: metal,
+            },
+        ],
+        camera: camera(Vec3::new(0.0, 1.5, 6.5), Vec3::ZERO, 160, 96),
+        point_lights: vec![],
+    };
+    // No light direction reaches one object past the other (they are 3 m apart, lights high).
+    let cone =
+        |d: Vec3, l: f32| DistantLight { direction: d.normalize(), solid_angle: 1e-5, radiance: Vec3::splat(l * 1e5) };
+    let lights = [
+        cone(Vec3::new(0.0, 1.0, 0.3), 2.0),
+        cone(Vec3::new(0.3, 0.6, 1.0), 1.5),
+        cone(Vec3::new(-0.8, 0.7, 0.1), 1.0),
+    ];
+    let sky = EnvMap::from_fn(64, 32, |d| Vec3::new(0.3, 0.4, 0.6) * (0.5 + 0.5 * d.y) + Vec3::splat(0.05));
+    let ambient = Sh9::project(&sky);
+    let shade_lights: Vec<ShadeLight> = lights.iter().map(ShadeLight::from).collect();
+    let (image, positions) = gpu_render(
+        &gpu,
+        &scene,
+        &ShadeParams { lights: &shade_lights, ambient: Some(&ambient), background: Some(&sky) },
+    );
+    let bvh = SceneBvh::new(&scene);
+    let set = LightSet {
+        lights: &lights,
+        interleaved: &[],
+        ambient: Some(ambient),
+        shadow_ambient: false,
+        background: Some(&sky),
+    };
+    let env = EnvLight::new(&sky);
+    let reference = render(
+        &scene,
+        &bvh,
+        Some(&env),
+        &Integrator::Lights(set),
+        &RenderSettings { spp: 16, seed: 7, time_budget: None, aovs: true },
+        &|_, _| {},
+    );
+    let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
+    let pixels = interior(&reference.object_id, &reference.normal, &positions, w, h);
+    for object in [0u32, 1, u32::MAX] {
+        let ks: Vec<usize> = pixels.iter().copied().filter(|&k| reference.object_id[k] == object).collect();
+        assert!(ks.len() > 200, "object {object}: only {} interior pixels", ks.len());
+        let mut rel: Vec<f32> = ks
+            .iter()
+            .map(|&k| ((image[k] - reference.color[k]).abs() / (reference.color[k] + Vec3::splat(0.01))).max_element())
+            .collect();
+        rel.sort_by(f32::total_cmp);
+        let mean = rel.iter().sum::<f32>() / rel.len() as f32;
+        let p99 = rel[rel.len() * 99 / 100];
+        assert!(mean < 0.01 && p99 < 0.05, "object {object}: relative error mean {mean}, 99th percentile {p99}");
+    }
+}
+
+#[test]
+fn point_light_over_a_lambertian_plane_matches_the_closed_form() {
+    let gpu = gpu();
+    let albedo = 0.6;
+    let scene = Scene {
+        name: "plane".into(),
+        objects: vec![Object {
+            name: "floor".into(),
+            mesh: Mesh::quad(Vec3::new(-5.0, 0.0, 5.0), Vec3::new(10.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -10.0), 1, 1),
+            material: Material::lambert(albedo),
+        }],
+        camera: camera(Vec3::new(0.0, 4.0, 4.0), Vec3::ZERO, 96, 64),
+        point_lights: vec![],
+    };
+    let light = PointLight { position: Vec3::new(0.5, 1.5, -0.5), intensity: Vec3::new(4.0, 3.0, 2.0) };
+    let lights = [ShadeLight::from(&light)];
+    let (image, positions) = gpu_render(&gpu, &scene, &ShadeParams { lights: &lights, ..Default::default() });
+    let mut checked = 0;
+    for (k, p) in positions.iter().enumerate() {
+        if p[3] < 0.0 {
+            assert_eq!(image[k], Vec3::ZERO, "no background: misses are black");
+            continue;
+        }
+        let x = Vec3::new(p[0], p[1], p[2]);
+        let d = light.position - x;
+        let want = light.intensity * (albedo / std::f32::consts::PI) * (d.y / d.length()) / d.length_squared();
+        let err = ((image[k] - want).abs() / want).max_element();
+        assert!(err < 1e-3, "pixel {k} at {x}: {} vs {want}", image[k]);
+        checked += 1;
+    }
+    assert!(checked > 1000);
+}
+
+#[test]
+fn adapter_is_described_and_sizes_beyond_the_limits_are_refused() {
+    let gpu = gpu();
+    assert!(!gpu.describe().is_empty());
+    let too_big = gpu.limits.max_texture_dimension_2d + 1;
+    let err = Visibility::new(&gpu, too_big, 4, 1).err().expect("refused");
+    assert!(err.to_string().contains("exceeds the adapter's limit"), "{err}");
+}

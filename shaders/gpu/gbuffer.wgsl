@@ -1,0 +1,60 @@
+// G-buffer pass: world position (w = object index, -1 where nothing was hit), shading normal
+// and geometric normal, both facing the camera as `ref-tracer` orients them.
+
+struct Camera {
+    view_proj: mat4x4<f32>,
+    eye: vec4<f32>,
+}
+
+@group(0) @binding(0) var<uniform> camera: Camera;
+
+struct VsIn {
+    @location(0) position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) geometric_normal: vec3<f32>,
+    @location(3) object: u32,
+}
+
+struct VsOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) @interpolate(flat) geometric_normal: vec3<f32>,
+    @location(3) @interpolate(flat) object: u32,
+}
+
+@vertex
+fn vs(v: VsIn) -> VsOut {
+    var out: VsOut;
+    out.clip = camera.view_proj * vec4<f32>(v.position, 1.0);
+    out.world = v.position;
+    out.normal = v.normal;
+    out.geometric_normal = v.geometric_normal;
+    out.object = v.object;
+    return out;
+}
+
+struct GBufferOut {
+    @location(0) position: vec4<f32>,
+    @location(1) normal: vec4<f32>,
+    @location(2) geometric_normal: vec4<f32>,
+}
+
+@fragment
+fn fs(in: VsOut) -> GBufferOut {
+    var ng = in.geometric_normal;
+    if dot(ng, camera.eye.xyz - in.world) < 0.0 {
+        ng = -ng;
+    }
+    var ns = in.normal;
+    let len = length(ns);
+    ns = select(ng, ns / len, len > 0.0);
+    if dot(ns, ng) < 0.0 {
+        ns = -ns;
+    }
+    var out: GBufferOut;
+    out.position = vec4<f32>(in.world, f32(in.object));
+    out.normal = vec4<f32>(ns, 0.0);
+    out.geometric_normal = vec4<f32>(ng, 0.0);
+    return out;
+}
