@@ -1,4 +1,4 @@
-// requires: gpu/brdf.wgsl gpu/sh9.wgsl
+// requires: gpu/brdf.wgsl gpu/sh9.wgsl gpu/fullscreen.wgsl
 // Shading pass: per pixel, the G-buffer surface lit by distant cone lights (as directional
 // lights carrying the cone's irradiance) and point lights, each times its visibility layer, plus
 // SH9 ambient on the diffuse lobe, as `ref-tracer`'s `lights` integrator; misses see the map.
@@ -31,13 +31,6 @@ struct Params {
 @group(0) @binding(5) var g_geometric_normal: texture_2d<f32>;
 @group(0) @binding(6) var visibility: texture_2d_array<f32>;
 @group(0) @binding(7) var background: texture_2d<f32>;
-
-@vertex
-fn vs(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
-    // one triangle covering the screen
-    let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
-    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
-}
 
 // Bilinear lat-long lookup, wrapping in u and clamping in v (`EnvMap::lookup`).
 fn background_radiance(dir: vec3<f32>) -> vec3<f32> {

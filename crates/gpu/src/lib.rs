@@ -12,6 +12,7 @@
 //! ```
 
 mod context;
+pub mod fullscreen;
 mod gbuffer;
 mod geometry;
 mod readback;

@@ -161,27 +161,7 @@ impl ShadingPass {
     #[must_use]
     pub fn new(gpu: &Gpu) -> Self {
         let module = crate::shader::module(&gpu.device, "shade", include_str!("../../../shaders/gpu/shade.wgsl"), &[]);
-        let pipeline = gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("shade"),
-            layout: None,
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs"),
-                compilation_options: Default::default(),
-                targets: &[Some(HDR_FORMAT.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = crate::fullscreen::pipeline(gpu, "shade", &module, HDR_FORMAT);
         Self { pipeline }
     }
 
@@ -282,26 +262,7 @@ impl ShadingPass {
             ],
         });
         let out_view = output.create_view(&Default::default());
-        let mut encoder = gpu.encoder("shade");
-        {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("shade"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &out_view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                ..Default::default()
-            });
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &bind, &[]);
-            pass.draw(0..3, 0..1);
-        }
-        gpu.submit_and_wait(encoder)?;
+        crate::fullscreen::draw(gpu, &self.pipeline, &bind, &out_view, wgpu::Color::BLACK)?;
         let rgba = crate::readback::read_texture_rgba(gpu, &output, 0)?;
         Ok(rgba.into_iter().map(|v| Vec3::new(v[0], v[1], v[2])).collect())
     }

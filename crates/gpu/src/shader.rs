@@ -7,6 +7,7 @@
 pub const LIBRARY: &[(&str, &str)] = &[
     ("gpu/brdf.wgsl", include_str!("../../../shaders/gpu/brdf.wgsl")),
     ("gpu/sh9.wgsl", include_str!("../../../shaders/gpu/sh9.wgsl")),
+    ("gpu/fullscreen.wgsl", include_str!("../../../shaders/gpu/fullscreen.wgsl")),
 ];
 
 /// The names listed on `// requires:` lines at the top of `source`.

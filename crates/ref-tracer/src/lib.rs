@@ -30,6 +30,7 @@ mod integrator;
 pub mod metrics;
 mod render;
 pub mod sampler;
+pub mod visibility;
 
 pub use bvh::{SceneBvh, SurfacePoint};
 pub use integrator::{EnvLight, Integrator, LightSet, Strategy};

@@ -1,0 +1,66 @@
+//! Full-screen passes: one triangle covering the target (`shaders/gpu/fullscreen.wgsl`'s `vs`),
+//! a fragment shader per pixel. The shading pass and every shadow technique's visibility pass
+//! are such passes.
+
+use crate::context::{Gpu, GpuError};
+
+/// A full-screen pipeline of `module` (entry points `vs` and `fs`) writing one `format` target.
+#[must_use]
+pub fn pipeline(
+    gpu: &Gpu,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    format: wgpu::TextureFormat,
+) -> wgpu::RenderPipeline {
+    gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: None,
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: wgpu::PrimitiveState::default(),
+        depth_stencil: None,
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some("fs"),
+            compilation_options: Default::default(),
+            targets: &[Some(format.into())],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// Runs `pipeline` with `bind` over `target` (cleared to `clear` first) and waits.
+///
+/// # Errors
+/// GPU failures.
+pub fn draw(
+    gpu: &Gpu,
+    pipeline: &wgpu::RenderPipeline,
+    bind: &wgpu::BindGroup,
+    target: &wgpu::TextureView,
+    clear: wgpu::Color,
+) -> Result<(), GpuError> {
+    let mut encoder = gpu.encoder("full-screen pass");
+    {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("full-screen pass"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: target,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(clear), store: wgpu::StoreOp::Store },
+            })],
+            ..Default::default()
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, bind, &[]);
+        pass.draw(0..3, 0..1);
+    }
+    gpu.submit_and_wait(encoder)
+}

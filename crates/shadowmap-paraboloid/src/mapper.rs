@@ -1,0 +1,410 @@
+//! The GPU side: depth passes for paraboloid, cube and orthographic maps (with per-map chunk
+//! culling), and the visibility pass that turns a map into a screen-space visibility layer.
+
+use crate::paraboloid::{Hemisphere, ParaboloidFrame};
+use crate::{Rejection, ShadowLight, ShadowSettings, Technique};
+use glam::{Mat4, Vec3};
+use gpu::{Chunk, Clock, GBuffer, Gpu, GpuError, ShadowGeometry};
+use std::time::Duration;
+use wgpu::util::DeviceExt;
+
+const LIBRARY: &[(&str, &str)] =
+    &[("shadowmap-paraboloid/paraboloid.wgsl", include_str!("../../../shaders/shadowmap-paraboloid/paraboloid.wgsl"))];
+
+/// Depth format of every shadow map: 32-bit float, readable back.
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// One rendered view of a shadow map (one layer of its texture).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowView {
+    /// Paraboloid: world -> light space; otherwise world -> clip.
+    pub matrix: Mat4,
+    /// Near distance (paraboloid) or 0.
+    pub near: f32,
+    /// Far distance (paraboloid), or the map's world extent (orthographic), or far (cube).
+    pub far: f32,
+    /// Whether this is a paraboloid view.
+    pub paraboloid: bool,
+    /// Side in texels.
+    pub resolution: u32,
+    /// Triangles drawn into it after culling.
+    pub triangles_drawn: u32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct ViewUniform {
+    matrix: [[f32; 4]; 4],
+    params: [f32; 4],
+}
+
+impl ShadowView {
+    fn uniform(&self) -> ViewUniform {
+        ViewUniform {
+            matrix: self.matrix.to_cols_array_2d(),
+            params: [self.near, self.far, if self.paraboloid { 0.0 } else { 1.0 }, self.resolution as f32],
+        }
+    }
+}
+
+/// A light's rendered shadow map.
+pub struct ShadowMap {
+    /// Depth32Float 2D array, one layer per view.
+    pub texture: wgpu::Texture,
+    /// The views, in layer order (paraboloid: front, back; cube: +X, -X, +Y, -Y, +Z, -Z).
+    pub views: Vec<ShadowView>,
+    /// The technique.
+    pub technique: Technique,
+    /// The light.
+    pub light: ShadowLight,
+    /// The paraboloid frame, for paraboloid maps.
+    pub frame: Option<ParaboloidFrame>,
+    /// The settings it was made with (rejection as actually used).
+    pub settings: ShadowSettings,
+    /// Generation time of all its passes.
+    pub time: Duration,
+    /// The clock `time` comes from.
+    pub clock: Clock,
+}
+
+impl ShadowMap {
+    /// Triangles drawn over all views.
+    #[must_use]
+    pub fn triangles_drawn(&self) -> u32 {
+        self.views.iter().map(|v| v.triangles_drawn).sum()
+    }
+
+    /// Reads one layer's depths back, row-major from the top-left.
+    ///
+    /// # Errors
+    /// GPU failures.
+    pub fn read_layer(&self, gpu: &Gpu, layer: u32) -> Result<Vec<f32>, GpuError> {
+        gpu::read_texture_f32(gpu, &self.texture, layer)
+    }
+}
+
+/// Pipelines of the shadow passes, built once.
+pub struct ShadowMapper {
+    paraboloid_clip: Option<wgpu::RenderPipeline>,
+    paraboloid_discard: wgpu::RenderPipeline,
+    matrix: wgpu::RenderPipeline,
+    visibility: wgpu::RenderPipeline,
+}
+
+fn depth_pipeline(gpu: &Gpu, label: &str, source: &str, fragment: bool) -> wgpu::RenderPipeline {
+    let module = gpu::shader::module(&gpu.device, label, source, LIBRARY);
+    gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: None,
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs"),
+            compilation_options: Default::default(),
+            buffers: &[Some(ShadowGeometry::LAYOUT)],
+        },
+        // no culling: closed and open meshes alike cast shadows from either side
+        primitive: wgpu::PrimitiveState::default(),
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: fragment.then(|| wgpu::FragmentState {
+            module: &module,
+            entry_point: Some("fs"),
+            compilation_options: Default::default(),
+            targets: &[],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// Whether a view can see a chunk.
+type ChunkFilter = Box<dyn Fn(&Chunk) -> bool>;
+
+/// Bounding sphere of all chunks (centre, radius).
+fn bounds(geometry: &ShadowGeometry) -> (Vec3, f32) {
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for c in &geometry.chunks {
+        lo = lo.min(c.center - Vec3::splat(c.radius));
+        hi = hi.max(c.center + Vec3::splat(c.radius));
+    }
+    if !lo.is_finite() {
+        return (Vec3::ZERO, 1.0);
+    }
+    let center = 0.5 * (lo + hi);
+    let radius = geometry.chunks.iter().map(|c| c.center.distance(center) + c.radius).fold(0.0, f32::max);
+    (center, radius.max(1e-6))
+}
+
+/// Farthest distance from `p` to any chunk.
+fn reach(geometry: &ShadowGeometry, p: Vec3) -> f32 {
+    geometry.chunks.iter().map(|c| c.center.distance(p) + c.radius).fold(0.0, f32::max)
+}
+
+/// Whether a chunk can appear in a 90° cube face looking along `a` with side axes `u`, `v`.
+fn in_cube_face(c: &Chunk, light: Vec3, a: Vec3, u: Vec3, v: Vec3) -> bool {
+    let q = c.center - light;
+    let r = c.radius * std::f32::consts::SQRT_2;
+    let (qa, qu, qv) = (q.dot(a), q.dot(u), q.dot(v));
+    qa - qu >= -r && qa + qu >= -r && qa - qv >= -r && qa + qv >= -r
+}
+
+/// The six cube faces: (forward, up) in the order +X, -X, +Y, -Y, +Z, -Z.
+pub const CUBE_FACES: [(Vec3, Vec3); 6] = [
+    (Vec3::X, Vec3::Y),
+    (Vec3::NEG_X, Vec3::Y),
+    (Vec3::Y, Vec3::Z),
+    (Vec3::NEG_Y, Vec3::Z),
+    (Vec3::Z, Vec3::Y),
+    (Vec3::NEG_Z, Vec3::Y),
+];
+
+impl ShadowMapper {
+    /// Builds the pipelines (the clip-distance one only where the adapter has the feature).
+    #[must_use]
+    pub fn new(gpu: &Gpu) -> Self {
+        let src = |name| match name {
+            "clip" => include_str!("../../../shaders/shadowmap-paraboloid/paraboloid_depth.wgsl"),
+            "discard" => include_str!("../../../shaders/shadowmap-paraboloid/paraboloid_depth_discard.wgsl"),
+            "matrix" => include_str!("../../../shaders/shadowmap-paraboloid/matrix_depth.wgsl"),
+            _ => include_str!("../../../shaders/shadowmap-paraboloid/visibility.wgsl"),
+        };
+        let module = gpu::shader::module(&gpu.device, "shadow visibility", src("visibility"), LIBRARY);
+        let visibility = gpu::fullscreen::pipeline(gpu, "shadow visibility", &module, gpu::Visibility::FORMAT);
+        Self {
+            paraboloid_clip: gpu
+                .has_clip_distances()
+                .then(|| depth_pipeline(gpu, "paraboloid clip", src("clip"), false)),
+            paraboloid_discard: depth_pipeline(gpu, "paraboloid discard", src("discard"), true),
+            matrix: depth_pipeline(gpu, "matrix depth", src("matrix"), false),
+            visibility,
+        }
+    }
+
+    /// Renders the shadow map of `light` with `technique`. A hemispherical point light gets one
+    /// paraboloid map, an omnidirectional one two.
+    ///
+    /// # Errors
+    /// [`GpuError::Failed`] for a technique that does not fit the light (a paraboloid or cube
+    /// map for a distant light, an orthographic map for a point light); sizes beyond the
+    /// adapter's limits; GPU failures.
+    pub fn render(
+        &self,
+        gpu: &Gpu,
+        geometry: &ShadowGeometry,
+        light: &ShadowLight,
+        technique: Technique,
+        settings: &ShadowSettings,
+    ) -> Result<ShadowMap, GpuError> {
+        let mut settings = *settings;
+        if self.paraboloid_clip.is_none() {
+            settings.rejection = Rejection::Discard;
+        }
+        let res = settings.resolution;
+        let (center, radius) = bounds(geometry);
+        let mut frame = None;
+        // (view, culling test) per layer
+        let mut views: Vec<(ShadowView, ChunkFilter)> = Vec::new();
+        let cull = settings.cull;
+        match (technique, *light) {
+            (Technique::DualParaboloid, ShadowLight::Point { position, hemisphere }) => {
+                let far = (reach(geometry, position) * 1.01).max(settings.near * 2.0);
+                let f = ParaboloidFrame::new(position, hemisphere.unwrap_or(Vec3::NEG_Y), settings.near, far);
+                frame = Some(f);
+                let maps: &[Hemisphere] =
+                    if hemisphere.is_some() { &[Hemisphere::Front] } else { &[Hemisphere::Front, Hemisphere::Back] };
+                for &h in maps {
+                    let axis = if h == Hemisphere::Front { f.forward } else { -f.forward };
+                    let view = ShadowView {
+                        matrix: f.world_to_light(h),
+                        near: f.near,
+                        far: f.far,
+                        paraboloid: true,
+                        resolution: res,
+                        triangles_drawn: 0,
+                    };
+                    views.push((view, Box::new(move |c: &Chunk| !cull || (c.center - position).dot(axis) > -c.radius)));
+                }
+            }
+            (Technique::Cube, ShadowLight::Point { position, .. }) => {
+                let far = (reach(geometry, position) * 1.01).max(settings.near * 2.0);
+                let proj =
+                    glam::camera::rh::proj::directx::perspective(std::f32::consts::FRAC_PI_2, 1.0, settings.near, far);
+                for (a, up) in CUBE_FACES {
+                    let matrix = proj * glam::camera::rh::view::look_to_mat4(position, a, up);
+                    let u = a.cross(up);
+                    let view = ShadowView {
+                        matrix,
+                        near: settings.near,
+                        far,
+                        paraboloid: false,
+                        resolution: res,
+                        triangles_drawn: 0,
+                    };
+                    views.push((view, Box::new(move |c: &Chunk| !cull || in_cube_face(c, position, a, u, up))));
+                }
+            }
+            (Technique::Orthographic, ShadowLight::Distant { direction }) => {
+                let d = direction.normalize_or(Vec3::Y);
+                let up = if d.y.abs() < 0.9 { Vec3::Y } else { Vec3::X };
+                let margin = radius * 0.01;
+                let eye = center + d * (radius + margin);
+                let matrix = glam::camera::rh::proj::directx::orthographic(
+                    -radius,
+                    radius,
+                    -radius,
+                    radius,
+                    0.0,
+                    2.0 * (radius + margin),
+                ) * glam::camera::rh::view::look_to_mat4(eye, -d, up);
+                let view = ShadowView {
+                    matrix,
+                    near: 0.0,
+                    far: 2.0 * radius,
+                    paraboloid: false,
+                    resolution: res,
+                    triangles_drawn: 0,
+                };
+                views.push((view, Box::new(|_: &Chunk| true)));
+            }
+            (t, l) => return Err(GpuError::Failed(format!("a {t:?} shadow map does not fit a {l:?}"))),
+        }
+        gpu.check_texture(res, res, views.len() as u32)?;
+        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("shadow map"),
+            size: wgpu::Extent3d { width: res, height: res, depth_or_array_layers: views.len() as u32 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: DEPTH_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let pipeline = match (technique, settings.rejection, &self.paraboloid_clip) {
+            (Technique::DualParaboloid, Rejection::ClipDistance, Some(p)) => p,
+            (Technique::DualParaboloid, _, _) => &self.paraboloid_discard,
+            _ => &self.matrix,
+        };
+        let layer_views: Vec<wgpu::TextureView> = (0..views.len() as u32)
+            .map(|layer| {
+                texture.create_view(&wgpu::TextureViewDescriptor {
+                    dimension: Some(wgpu::TextureViewDimension::D2),
+                    base_array_layer: layer,
+                    array_layer_count: Some(1),
+                    ..Default::default()
+                })
+            })
+            .collect();
+        let binds: Vec<wgpu::BindGroup> = views
+            .iter()
+            .map(|(v, _)| {
+                let buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("shadow view"),
+                    contents: bytemuck::bytes_of(&v.uniform()),
+                    usage: wgpu::BufferUsages::UNIFORM,
+                });
+                gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("shadow view"),
+                    layout: &pipeline.get_bind_group_layout(0),
+                    entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }],
+                })
+            })
+            .collect();
+        let mut drawn = vec![0; views.len()];
+        let (time, clock) = gpu.measure(|encoder| {
+            for (k, ((_, visible), bind)) in views.iter().zip(&binds).enumerate() {
+                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("shadow depth"),
+                    color_attachments: &[],
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view: &layer_views[k],
+                        depth_ops: Some(wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(1.0),
+                            store: wgpu::StoreOp::Store,
+                        }),
+                        stencil_ops: None,
+                    }),
+                    ..Default::default()
+                });
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, bind, &[]);
+                drawn[k] = geometry.draw(&mut pass, visible);
+            }
+        })?;
+        let views =
+            views.into_iter().zip(drawn).map(|((v, _), triangles_drawn)| ShadowView { triangles_drawn, ..v }).collect();
+        Ok(ShadowMap { texture, views, technique, light: *light, frame, settings, time, clock })
+    }
+
+    /// Writes `map`'s visibility of each G-buffer pixel into `target` (a visibility layer):
+    /// 1 lit, 0 shadowed, fractions with PCF; 0 behind a hemispherical light.
+    ///
+    /// # Errors
+    /// GPU failures.
+    pub fn visibility(
+        &self,
+        gpu: &Gpu,
+        map: &ShadowMap,
+        gbuffer: &GBuffer,
+        target: &wgpu::TextureView,
+    ) -> Result<(), GpuError> {
+        #[repr(C)]
+        #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+        struct Params {
+            light: [f32; 4],
+            forward: [f32; 4],
+            config: [f32; 4],
+            views: [ViewUniform; 6],
+        }
+        let (light, kind) = match map.light {
+            ShadowLight::Point { position, .. } => (position, 0.0),
+            ShadowLight::Distant { direction } => (direction.normalize_or(Vec3::Y), 1.0),
+        };
+        let technique = match map.technique {
+            Technique::DualParaboloid => 0.0,
+            Technique::Cube => 1.0,
+            Technique::Orthographic => 2.0,
+        };
+        let mut views = [bytemuck::Zeroable::zeroed(); 6];
+        for (slot, v) in views.iter_mut().zip(&map.views) {
+            *slot = v.uniform();
+        }
+        let forward = map.frame.map_or(Vec3::ZERO, |f| f.forward);
+        let params = Params {
+            light: light.extend(kind).to_array(),
+            forward: forward.extend(0.0).to_array(),
+            config: [technique, map.views.len() as f32, map.settings.pcf_radius as f32, map.settings.bias_texels],
+            views,
+        };
+        let buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("visibility params"),
+            contents: bytemuck::bytes_of(&params),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let position = gbuffer.position.create_view(&Default::default());
+        let normal = gbuffer.geometric_normal.create_view(&Default::default());
+        let shadow = map.texture.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            aspect: wgpu::TextureAspect::DepthOnly,
+            ..Default::default()
+        });
+        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("visibility"),
+            layout: &self.visibility.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&position) },
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&normal) },
+                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&shadow) },
+            ],
+        });
+        gpu::fullscreen::draw(gpu, &self.visibility, &bind, target, wgpu::Color::WHITE)
+    }
+}

@@ -1,0 +1,283 @@
+//! Shadow maps on the GPU (lavapipe where there is no GPU) against the CPU paraboloid rasterizer
+//! and against ray-traced visibility from `ref-tracer`, with the extremes: the singular
+//! direction, the hemisphere boundary, tiny and huge scales, a light inside an occluder.
+
+use glam::Vec3;
+use gpu::{GBuffer, Gpu, SceneGeometry, ShadowGeometry, Visibility, scene_triangles};
+use ref_tracer::SceneBvh;
+use ref_tracer::visibility::{VisibilityLight, light_visibility};
+use scene::{Material, Mesh, Object, Scene};
+use shadowmap_paraboloid::cpu::{CpuParaboloidMap, lit};
+use shadowmap_paraboloid::paraboloid::Hemisphere;
+use shadowmap_paraboloid::{
+    Rejection, ShadowLight, ShadowMap, ShadowMapper, ShadowSettings, Technique, disagreement, shadow_triangles,
+};
+
+fn gpu() -> Gpu {
+    Gpu::new().unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn room(w: u32, h: u32) -> Scene {
+    let mut s = Scene::builtin("room").unwrap();
+    s.camera.width = w;
+    s.camera.height = h;
+    s
+}
+
+/// G-buffer points (position, geometric normal) of the scene's view; background as NaN.
+fn receivers(gpu: &Gpu, gb: &GBuffer) -> Vec<(Vec3, Vec3)> {
+    let p = gb.read_positions(gpu).unwrap();
+    let n = gb.read_geometric_normals(gpu).unwrap();
+    p.iter()
+        .zip(&n)
+        .map(|(p, n)| {
+            if p[3] < 0.0 {
+                (Vec3::NAN, Vec3::ZERO)
+            } else {
+                (Vec3::new(p[0], p[1], p[2]), Vec3::new(n[0], n[1], n[2]))
+            }
+        })
+        .collect()
+}
+
+struct Setup {
+    gpu: Gpu,
+    scene: Scene,
+    gb: GBuffer,
+    mapper: ShadowMapper,
+}
+
+impl Setup {
+    fn new(scene: Scene) -> Self {
+        let gpu = gpu();
+        let geometry = SceneGeometry::upload(&gpu, &scene).unwrap();
+        let gb = GBuffer::render(&gpu, &geometry, &scene.camera).unwrap();
+        let mapper = ShadowMapper::new(&gpu);
+        Self { gpu, scene, gb, mapper }
+    }
+
+    fn map(&self, triangles: &[[Vec3; 3]], light: &ShadowLight, t: Technique, s: &ShadowSettings) -> ShadowMap {
+        let triangles = shadow_triangles(triangles, light, t, s);
+        let geometry = ShadowGeometry::upload(&self.gpu, &triangles, ShadowGeometry::CHUNK_TRIANGLES).unwrap();
+        self.mapper.render(&self.gpu, &geometry, light, t, s).unwrap()
+    }
+
+    fn mask(&self, map: &ShadowMap) -> Vec<f32> {
+        let (w, h) = self.gb.size();
+        let vis = Visibility::new(&self.gpu, w, h, 1).unwrap();
+        self.mapper.visibility(&self.gpu, map, &self.gb, &vis.layer(0)).unwrap();
+        vis.read(&self.gpu, 0).unwrap()
+    }
+
+    fn truth(&self, light: VisibilityLight) -> Vec<Option<bool>> {
+        light_visibility(&SceneBvh::new(&self.scene), &receivers(&self.gpu, &self.gb), light)
+    }
+}
+
+#[test]
+fn gpu_paraboloid_maps_match_the_cpu_rasterizer() {
+    let s = Setup::new(room(8, 8));
+    let tris = scene_triangles(&s.scene);
+    let light = ShadowLight::omni(s.scene.point_lights[0].position);
+    for rejection in [Rejection::ClipDistance, Rejection::Discard] {
+        let settings =
+            ShadowSettings { resolution: 256, rejection, subdivide_angle: None, ..ShadowSettings::default() };
+        let map = s.map(&tris, &light, Technique::DualParaboloid, &settings);
+        let frame = map.frame.unwrap();
+        for (layer, h) in [Hemisphere::Front, Hemisphere::Back].into_iter().enumerate() {
+            let gpu_depth = map.read_layer(&s.gpu, layer as u32).unwrap();
+            let cpu = CpuParaboloidMap::rasterize(&frame, h, 256, &tris);
+            let off = gpu_depth.iter().zip(&cpu.depth).filter(|(g, c)| (*g - *c).abs() > 1e-4).count();
+            let frac = off as f64 / gpu_depth.len() as f64;
+            assert!(frac < 0.01, "{rejection:?} {h:?}: {:.2} % of texels differ", frac * 100.0);
+        }
+    }
+}
+
+#[test]
+fn gpu_visibility_matches_the_cpu_shadow_test() {
+    let s = Setup::new(room(160, 120));
+    let tris = scene_triangles(&s.scene);
+    let light = ShadowLight::omni(s.scene.point_lights[0].position);
+    let settings = ShadowSettings { resolution: 512, subdivide_angle: None, ..ShadowSettings::default() };
+    let map = s.map(&tris, &light, Technique::DualParaboloid, &settings);
+    let frame = map.frame.unwrap();
+    let cpu_maps = [Hemisphere::Front, Hemisphere::Back].map(|h| CpuParaboloidMap::rasterize(&frame, h, 512, &tris));
+    let mask = s.mask(&map);
+    let truth: Vec<Option<bool>> = receivers(&s.gpu, &s.gb)
+        .iter()
+        .map(|&(p, n)| if p.is_finite() { lit(&cpu_maps, p, n, settings.bias_texels) } else { None })
+        .collect();
+    let (frac, n) = disagreement(&mask, &truth);
+    assert!(n > 10_000 && frac < 0.005, "GPU and CPU shadow tests disagree on {:.3} % of {n} pixels", frac * 100.0);
+}
+
+#[test]
+fn paraboloid_and_cube_agree_with_ray_traced_visibility_in_the_room() {
+    let s = Setup::new(room(320, 240));
+    let tris = scene_triangles(&s.scene);
+    let position = s.scene.point_lights[0].position;
+    let truth = s.truth(VisibilityLight::Point(position));
+    for (technique, res) in [(Technique::DualParaboloid, 1024), (Technique::Cube, 592)] {
+        for rejection in [Rejection::ClipDistance, Rejection::Discard] {
+            let settings = ShadowSettings { resolution: res, rejection, ..ShadowSettings::default() };
+            let map = s.map(&tris, &ShadowLight::omni(position), technique, &settings);
+            let (frac, n) = disagreement(&s.mask(&map), &truth);
+            assert!(n > 50_000 && frac < 0.002, "{technique:?} {rejection:?}: {:.3} % disagree", frac * 100.0);
+        }
+    }
+}
+
+#[test]
+fn a_hemispherical_light_gets_one_map_and_lights_only_its_hemisphere() {
+    let s = Setup::new(room(160, 120));
+    let tris = scene_triangles(&s.scene);
+    let position = s.scene.point_lights[0].position;
+    let light = ShadowLight::Point { position, hemisphere: Some(Vec3::NEG_Y) };
+    let map = s.map(&tris, &light, Technique::DualParaboloid, &ShadowSettings::default());
+    assert_eq!(map.views.len(), 1);
+    let mask = s.mask(&map);
+    let points = receivers(&s.gpu, &s.gb);
+    let truth = s.truth(VisibilityLight::Point(position));
+    let (mut above, mut wrong_below) = (0, 0);
+    for ((m, (p, _)), t) in mask.iter().zip(&points).zip(&truth) {
+        if p.is_finite() && p.y > position.y + 0.05 {
+            above += 1;
+            assert_eq!(*m, 0.0, "{p} is behind the light's hemisphere");
+        } else if let Some(t) = t {
+            wrong_below += usize::from((*m > 0.5) != *t);
+        }
+    }
+    assert!(above > 1000, "the view sees the ceiling");
+    assert!((wrong_below as f64) < 0.01 * mask.len() as f64, "{wrong_below} pixels wrong below the light");
+}
+
+#[test]
+fn the_singular_direction_leaves_the_front_map_clean() {
+    // An occluder straight behind the front map's axis (z -> -1) lands at the back map's centre
+    // and nowhere in the front map, with both rejection modes.
+    let s = Setup::new(room(8, 8));
+    let position = Vec3::new(0.0, 2.0, 0.0);
+    let occluder = Mesh::cuboid(Vec3::new(-0.05, 2.5, -0.05), Vec3::new(0.05, 2.6, 0.05));
+    let tris: Vec<[Vec3; 3]> = (0..occluder.indices.len()).map(|t| occluder.triangle(t)).collect();
+    for rejection in [Rejection::ClipDistance, Rejection::Discard] {
+        let settings = ShadowSettings { resolution: 128, rejection, cull: false, ..ShadowSettings::default() };
+        // front axis -Y: the occluder above is at z = -1 of the front map
+        let map =
+            s.map(&tris, &ShadowLight::Point { position, hemisphere: None }, Technique::DualParaboloid, &settings);
+        let front = map.read_layer(&s.gpu, 0).unwrap();
+        assert!(front.iter().all(|d| *d == 1.0), "{rejection:?}: front map drew the occluder behind it");
+        let back = map.read_layer(&s.gpu, 1).unwrap();
+        assert!(
+            back[64 * 128 + 64] < 1.0 && back.iter().all(|d| d.is_finite()),
+            "{rejection:?}: back map centre empty"
+        );
+    }
+}
+
+#[test]
+fn an_occluder_across_the_hemisphere_boundary_shadows_both_sides() {
+    // A wall standing in the rim plane y = 2 of a light facing down: half in each map.
+    let mut scene = room(160, 120);
+    scene.objects.push(Object {
+        name: "screen".into(),
+        mesh: Mesh::cuboid(Vec3::new(0.8, 1.2, -1.0), Vec3::new(1.0, 2.8, 1.0)),
+        material: Material::lambert(0.5),
+    });
+    let s = Setup::new(scene);
+    let tris = scene_triangles(&s.scene);
+    let position = s.scene.point_lights[0].position;
+    let truth = s.truth(VisibilityLight::Point(position));
+    let plain = ShadowSettings { subdivide_angle: None, ..ShadowSettings::default() };
+    let map = s.map(&tris, &ShadowLight::omni(position), Technique::DualParaboloid, &plain);
+    let (frac, _) = disagreement(&s.mask(&map), &truth);
+    // the boundary is where linear interpolation of the non-linear mapping is worst
+    let map = s.map(&tris, &ShadowLight::omni(position), Technique::DualParaboloid, &ShadowSettings::default());
+    let (frac_sub, _) = disagreement(&s.mask(&map), &truth);
+    assert!(frac_sub < 0.002 && frac_sub * 4.0 < frac, "disagreement {frac} plain, {frac_sub} subdivided");
+}
+
+#[test]
+fn tiny_and_huge_scenes_shadow_alike() {
+    let mut fracs = Vec::new();
+    for scale in [1e-3f32, 1.0, 1e3] {
+        let mut scene = room(160, 120);
+        for o in &mut scene.objects {
+            for p in &mut o.mesh.positions {
+                *p *= scale;
+            }
+        }
+        scene.camera.eye *= scale;
+        scene.camera.target *= scale;
+        scene.point_lights[0].position *= scale;
+        let s = Setup::new(scene);
+        let position = s.scene.point_lights[0].position;
+        let settings = ShadowSettings { near: 0.01 * scale, ..ShadowSettings::default() };
+        let map = s.map(&scene_triangles(&s.scene), &ShadowLight::omni(position), Technique::DualParaboloid, &settings);
+        let (frac, n) = disagreement(&s.mask(&map), &s.truth(VisibilityLight::Point(position)));
+        assert!(n > 10_000);
+        fracs.push(frac);
+    }
+    assert!(fracs.iter().all(|f| *f < 0.002), "disagreement at scales 1e-3, 1, 1e3: {fracs:?}");
+}
+
+#[test]
+fn a_light_inside_an_occluder_shadows_everything_outside() {
+    let mut scene = room(160, 120);
+    let position = scene.point_lights[0].position;
+    scene.objects.push(Object {
+        name: "lamp shade".into(),
+        mesh: Mesh::cuboid(position - Vec3::splat(0.2), position + Vec3::splat(0.2)),
+        material: Material::lambert(0.5),
+    });
+    let s = Setup::new(scene);
+    let tris = scene_triangles(&s.scene);
+    for technique in [Technique::DualParaboloid, Technique::Cube] {
+        let map = s.map(&tris, &ShadowLight::omni(position), technique, &ShadowSettings::fast());
+        let mask = s.mask(&map);
+        let points = receivers(&s.gpu, &s.gb);
+        let outside: Vec<f32> = mask
+            .iter()
+            .zip(&points)
+            .filter(|(_, (p, _))| p.is_finite() && (*p - position).abs().max_element() > 0.25)
+            .map(|(m, _)| *m)
+            .collect();
+        assert!(outside.len() > 10_000 && outside.iter().all(|m| *m == 0.0), "{technique:?}: light leaks out");
+    }
+}
+
+#[test]
+fn orthographic_map_of_a_distant_light_agrees_with_ray_tracing() {
+    let mut scene = Scene::builtin("spheres_box").unwrap();
+    scene.camera.width = 320;
+    scene.camera.height = 240;
+    // the ground is 100 m wide: shadow only what is near the objects, where the view looks
+    scene.objects[0].mesh =
+        Mesh::quad(Vec3::new(-6.0, 0.0, 6.0), Vec3::new(12.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -12.0), 1, 1);
+    let s = Setup::new(scene);
+    let tris = scene_triangles(&s.scene);
+    let dir = Vec3::new(0.4, 0.8, 0.3).normalize();
+    let map =
+        s.map(&tris, &ShadowLight::Distant { direction: dir }, Technique::Orthographic, &ShadowSettings::quality());
+    let (frac, n) = disagreement(&s.mask(&map), &s.truth(VisibilityLight::Distant(dir)));
+    assert!(n > 30_000 && frac < 0.01, "{:.3} % disagree", frac * 100.0);
+}
+
+#[test]
+fn mismatched_technique_and_light_is_an_error() {
+    let s = Setup::new(room(8, 8));
+    let tris = scene_triangles(&s.scene);
+    let geometry = ShadowGeometry::upload(&s.gpu, &tris, 64).unwrap();
+    let err = s
+        .mapper
+        .render(
+            &s.gpu,
+            &geometry,
+            &ShadowLight::Distant { direction: Vec3::Y },
+            Technique::Cube,
+            &ShadowSettings::fast(),
+        )
+        .err()
+        .expect("refused");
+    assert!(err.to_string().contains("does not fit"), "{err}");
+}
