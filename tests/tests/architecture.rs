@@ -86,3 +86,19 @@ fn light_extract_and_ref_tracer_never_touch_wgpu() {
         assert!(gpu.is_empty(), "{krate} depends on {gpu:?}");
     }
 }
+
+#[test]
+fn gpu_layer_and_shadow_techniques_stand_apart_from_the_reference() {
+    // gpu builds only on envmap-sphere and scene; shadow techniques build on gpu, never on the
+    // reference tracer or light extraction (they are measured against the reference in tests
+    // and in `xtask validate`, not built on it).
+    let graph = dependency_graph();
+    let gpu = transitive(&graph, "gpu");
+    assert!(gpu.contains("wgpu") && gpu.contains("scene"), "gpu's graph is incomplete: {gpu:?}");
+    let ours: Vec<_> = gpu.iter().filter(|d| OURS.contains(&d.as_str()) && *d != "envmap-sphere").collect();
+    assert!(ours.is_empty(), "gpu depends on {ours:?}");
+    let shadows = transitive(&graph, "shadowmap-paraboloid");
+    for banned in ["ref-tracer", "light-extract", "obvhs"] {
+        assert!(!shadows.contains(banned), "shadowmap-paraboloid depends on {banned}");
+    }
+}

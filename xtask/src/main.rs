@@ -25,13 +25,11 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// The main job: the whole pipeline on the default (or given) map, checked against the
-    /// reference. For now: load the map and print its statistics.
-    Validate {
-        /// Environment map (.exr or .hdr); the embedded default map when absent.
-        #[arg(long)]
-        envmap: Option<PathBuf>,
-    },
+    /// The main job: decompose the map into lights, render them on the GPU (lavapipe) with
+    /// shadow maps, render the ref-tracer reference, measure point-light shadow maps on `room`,
+    /// and write target/validate/report.html. Fails when an error exceeds
+    /// validate/thresholds.json.
+    Validate(validate::ValidateArgs),
     /// Run the test suite (installs lavapipe first where it is missing and we are root).
     Test {
         /// Extra arguments passed to `cargo test` (after `--`).
@@ -118,7 +116,7 @@ pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Validate { envmap } => validate::run(envmap.as_deref()),
+        Command::Validate(args) => validate::run(&args),
         Command::Test { args } => test::run(&args),
         Command::Info { path, json } => info::run(&path, json),
         Command::Scene { name, obj } => scene::run(&name, &obj),

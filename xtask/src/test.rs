@@ -1,7 +1,9 @@
 //! `cargo xtask test`: the whole test suite, as CI runs it.
 //!
-//! Unit, integration and doc tests of every crate, plus one smoke run of every criterion bench
-//! (so benches never rot). Prints the wall time.
+//! Unit, integration and doc tests of every crate (the GPU ones on lavapipe where there is no
+//! GPU), one smoke run of every criterion bench (so benches never rot), and — when no test
+//! filter is given — the main job, `cargo xtask validate --quick`, with its thresholds. Prints
+//! the wall time.
 
 use std::process::Command;
 use std::time::Instant;
@@ -24,6 +26,15 @@ pub fn run(extra: &[String]) -> Result<(), String> {
         if !status.success() {
             return Err(format!("cargo {} failed ({status})", args.join(" ")));
         }
+    }
+    if extra.is_empty() {
+        println!("xtask test: cargo xtask validate --quick");
+        crate::validate::run(&crate::validate::ValidateArgs {
+            envmap: None,
+            scene: "spheres_box".into(),
+            quick: true,
+            out: "target/validate".into(),
+        })?;
     }
     println!("xtask test: all passed in {:.0} s", start.elapsed().as_secs_f64());
     Ok(())

@@ -68,12 +68,28 @@ fn bad_input_exits_one_with_one_line_naming_the_file() {
 }
 
 #[test]
-fn validate_runs_on_the_embedded_default_map() {
-    let out = xtask(&["validate"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+fn validate_quick_writes_a_self_contained_report_and_meets_its_thresholds() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli-validate");
+    let out = xtask(&["validate", "--quick", "--out", dir.to_str().unwrap_or_default()]);
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(text.contains("city.exr (embedded default") && text.contains("1024 x 512"), "{text}");
-    assert!(text.contains("clamped       506 negative values"), "{text}");
+    assert!(out.status.success(), "{text}\n{}", String::from_utf8_lossy(&out.stderr));
+    assert!(text.contains("[1/8] load environment map") && text.contains("[8/8] report"), "{text}");
+    assert!(text.contains("thresholds met") && !text.contains(" 0 thresholds met"), "{text}");
+    let html = std::fs::read_to_string(dir.join("report.html")).expect("report written");
+    assert!(html.contains("data:image/png;base64,") && !html.contains("src=\"http"), "images embedded");
+    for row in ["reference", "lights_ray_traced", "gpu_shadow_maps", "paraboloid_1024_clip", "cube_592", "GPU adapter"]
+    {
+        assert!(html.contains(row), "report lacks {row}");
+    }
+}
+
+#[test]
+fn validate_refuses_an_unknown_scene_in_one_line() {
+    let out = xtask(&["validate", "--quick", "--scene", "nowhere"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(err.contains("nowhere") && err.contains("spheres_box"), "{err}");
 }
 
 #[test]

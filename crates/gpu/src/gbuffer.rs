@@ -172,6 +172,26 @@ impl GBuffer {
         crate::readback::read_texture_rgba(gpu, &self.position, 0)
     }
 
+    /// Reads the visible surface points back as (position, geometric normal facing the camera),
+    /// row-major; background pixels have a NaN position.
+    ///
+    /// # Errors
+    /// GPU failures.
+    pub fn read_points(&self, gpu: &Gpu) -> Result<Vec<(Vec3, Vec3)>, GpuError> {
+        let p = self.read_positions(gpu)?;
+        let n = self.read_geometric_normals(gpu)?;
+        Ok(p.iter()
+            .zip(&n)
+            .map(|(p, n)| {
+                if p[3] < 0.0 {
+                    (Vec3::NAN, Vec3::ZERO)
+                } else {
+                    (Vec3::new(p[0], p[1], p[2]), Vec3::new(n[0], n[1], n[2]))
+                }
+            })
+            .collect())
+    }
+
     /// Reads the geometric normals back, row-major.
     ///
     /// # Errors

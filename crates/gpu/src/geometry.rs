@@ -135,7 +135,7 @@ pub struct ShadowGeometry {
 impl ShadowGeometry {
     /// Triangles per chunk by default: small enough to cull walls row by row, large enough that
     /// draw calls stay few.
-    pub const CHUNK_TRIANGLES: usize = 64;
+    pub const CHUNK_TRIANGLES: usize = 16;
 
     /// Uploads `triangles` (world space) in chunks of `chunk_triangles` consecutive triangles.
     ///

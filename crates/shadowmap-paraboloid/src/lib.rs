@@ -94,6 +94,10 @@ pub struct ShadowSettings {
     /// For paraboloid maps: bisect triangles until each edge spans at most this angle from the
     /// light (radians), see [`shadow_triangles`]; `None` draws the triangles as they are.
     pub subdivide_angle: Option<f32>,
+    /// For orthographic maps: the sphere (centre, radius) of receivers that need shadows, e.g.
+    /// what the camera sees; the map then spends its texels there (casters between it and the
+    /// light still count). `None`: the whole scene.
+    pub focus: Option<(Vec3, f32)>,
 }
 
 impl Default for ShadowSettings {
@@ -109,6 +113,7 @@ impl Default for ShadowSettings {
             cull: true,
             near: 0.01,
             subdivide_angle: Some(0.2),
+            focus: None,
         }
     }
 }
@@ -158,4 +163,53 @@ pub fn disagreement(mask: &[f32], truth: &[Option<bool>]) -> (f64, usize) {
         }
     }
     (if n == 0 { 0.0 } else { wrong as f64 / n as f64 }, n)
+}
+
+/// Map sides with (nearly) equal texel counts: a dual paraboloid map of side `p` (2 p² texels)
+/// against a cube map of side `c` (6 c² texels), c = p / √3 rounded to a multiple of 8. The
+/// accuracy and speed comparisons use these pairs.
+pub const EQUAL_TEXEL_SIDES: [(u32, u32); 3] = [(512, 296), (1024, 592), (2048, 1184)];
+
+/// A named shadow-map configuration.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Variant {
+    /// Name, e.g. `paraboloid_1024_clip_subdivided`.
+    pub name: String,
+    /// The technique.
+    pub technique: Technique,
+    /// Its settings.
+    pub settings: ShadowSettings,
+}
+
+/// The paraboloid-against-cube comparison of the validate report and the bench: for each pair of
+/// [`EQUAL_TEXEL_SIDES`], the cube map and the dual paraboloid map with clip distances (plain and
+/// subdivided) and with a discard (subdivided).
+#[must_use]
+pub fn equal_texel_variants() -> Vec<Variant> {
+    let mut out = Vec::new();
+    for (p, c) in EQUAL_TEXEL_SIDES {
+        let base = ShadowSettings::default();
+        let variant = |name: String, technique, resolution, rejection, subdivide_angle| Variant {
+            name,
+            technique,
+            settings: ShadowSettings { resolution, rejection, subdivide_angle, ..base },
+        };
+        out.push(variant(format!("cube_{c}"), Technique::Cube, c, Rejection::ClipDistance, None));
+        out.push(variant(format!("paraboloid_{p}_clip"), Technique::DualParaboloid, p, Rejection::ClipDistance, None));
+        out.push(variant(
+            format!("paraboloid_{p}_clip_subdivided"),
+            Technique::DualParaboloid,
+            p,
+            Rejection::ClipDistance,
+            base.subdivide_angle,
+        ));
+        out.push(variant(
+            format!("paraboloid_{p}_discard_subdivided"),
+            Technique::DualParaboloid,
+            p,
+            Rejection::Discard,
+            base.subdivide_angle,
+        ));
+    }
+    out
 }

@@ -85,17 +85,26 @@ impl ShadowMap {
 
 /// Pipelines of the shadow passes, built once.
 pub struct ShadowMapper {
+    view_layout: wgpu::BindGroupLayout,
     paraboloid_clip: Option<wgpu::RenderPipeline>,
     paraboloid_discard: wgpu::RenderPipeline,
+    // paraboloid without rejection, for chunks wholly inside a hemisphere
+    paraboloid_plain: wgpu::RenderPipeline,
     matrix: wgpu::RenderPipeline,
     visibility: wgpu::RenderPipeline,
 }
 
-fn depth_pipeline(gpu: &Gpu, label: &str, source: &str, fragment: bool) -> wgpu::RenderPipeline {
+fn depth_pipeline(
+    gpu: &Gpu,
+    layout: &wgpu::PipelineLayout,
+    label: &str,
+    source: &str,
+    fragment: bool,
+) -> wgpu::RenderPipeline {
     let module = gpu::shader::module(&gpu.device, label, source, LIBRARY);
     gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
-        layout: None,
+        layout: Some(layout),
         vertex: wgpu::VertexState {
             module: &module,
             entry_point: Some("vs"),
@@ -123,8 +132,43 @@ fn depth_pipeline(gpu: &Gpu, label: &str, source: &str, fragment: bool) -> wgpu:
     })
 }
 
-/// Whether a view can see a chunk.
-type ChunkFilter = Box<dyn Fn(&Chunk) -> bool>;
+/// What a view does with a chunk.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Class {
+    /// Culled: the view cannot see it.
+    Skip,
+    /// Wholly inside the view: drawn without rejection.
+    Inside,
+    /// Across a paraboloid map's band edge: drawn with the rejection (clip distance or discard).
+    Straddle,
+}
+
+/// How a view classifies chunks.
+type Classifier = Box<dyn Fn(&Chunk) -> Class>;
+
+/// Range of z / |d| over a sphere (centre `q` relative to the light, radius `r`) for unit
+/// `axis`: the cosines of the nearest and farthest angles from the axis.
+fn cos_range(q: Vec3, r: f32, axis: Vec3) -> (f32, f32) {
+    let len = q.length();
+    if len <= r {
+        return (-1.0, 1.0);
+    }
+    let theta = (q.dot(axis) / len).clamp(-1.0, 1.0).acos();
+    let spread = (r / len).asin();
+    ((theta + spread).min(std::f32::consts::PI).cos(), (theta - spread).max(0.0).cos())
+}
+
+/// A paraboloid view's class of a chunk: outside its band, inside its hemisphere, or across.
+fn paraboloid_class(c: &Chunk, light: Vec3, axis: Vec3) -> Class {
+    let (lo, hi) = cos_range(c.center - light, c.radius, axis);
+    if hi < -crate::paraboloid::RIM_MARGIN {
+        Class::Skip
+    } else if lo >= 0.0 {
+        Class::Inside
+    } else {
+        Class::Straddle
+    }
+}
 
 /// Bounding sphere of all chunks (centre, radius).
 fn bounds(geometry: &ShadowGeometry) -> (Vec3, f32) {
@@ -176,12 +220,32 @@ impl ShadowMapper {
         };
         let module = gpu::shader::module(&gpu.device, "shadow visibility", src("visibility"), LIBRARY);
         let visibility = gpu::fullscreen::pipeline(gpu, "shadow visibility", &module, gpu::Visibility::FORMAT);
+        let view_layout = gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("shadow view"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            }],
+        });
+        let layout = gpu.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("shadow depth"),
+            bind_group_layouts: &[Some(&view_layout)],
+            immediate_size: 0,
+        });
         Self {
             paraboloid_clip: gpu
                 .has_clip_distances()
-                .then(|| depth_pipeline(gpu, "paraboloid clip", src("clip"), false)),
-            paraboloid_discard: depth_pipeline(gpu, "paraboloid discard", src("discard"), true),
-            matrix: depth_pipeline(gpu, "matrix depth", src("matrix"), false),
+                .then(|| depth_pipeline(gpu, &layout, "paraboloid clip", src("clip"), false)),
+            paraboloid_discard: depth_pipeline(gpu, &layout, "paraboloid discard", src("discard"), true),
+            paraboloid_plain: depth_pipeline(gpu, &layout, "paraboloid plain", src("discard"), false),
+            matrix: depth_pipeline(gpu, &layout, "matrix depth", src("matrix"), false),
+            view_layout,
             visibility,
         }
     }
@@ -209,7 +273,7 @@ impl ShadowMapper {
         let (center, radius) = bounds(geometry);
         let mut frame = None;
         // (view, culling test) per layer
-        let mut views: Vec<(ShadowView, ChunkFilter)> = Vec::new();
+        let mut views: Vec<(ShadowView, Classifier)> = Vec::new();
         let cull = settings.cull;
         match (technique, *light) {
             (Technique::DualParaboloid, ShadowLight::Point { position, hemisphere }) => {
@@ -228,7 +292,13 @@ impl ShadowMapper {
                         resolution: res,
                         triangles_drawn: 0,
                     };
-                    views.push((view, Box::new(move |c: &Chunk| !cull || (c.center - position).dot(axis) > -c.radius)));
+                    // without culling every chunk goes through the rejection, as in the paper
+                    views.push((
+                        view,
+                        Box::new(
+                            move |c: &Chunk| if cull { paraboloid_class(c, position, axis) } else { Class::Straddle },
+                        ),
+                    ));
                 }
             }
             (Technique::Cube, ShadowLight::Point { position, .. }) => {
@@ -246,31 +316,35 @@ impl ShadowMapper {
                         resolution: res,
                         triangles_drawn: 0,
                     };
-                    views.push((view, Box::new(move |c: &Chunk| !cull || in_cube_face(c, position, a, u, up))));
+                    views.push((
+                        view,
+                        Box::new(move |c: &Chunk| {
+                            if !cull || in_cube_face(c, position, a, u, up) { Class::Inside } else { Class::Skip }
+                        }),
+                    ));
                 }
             }
             (Technique::Orthographic, ShadowLight::Distant { direction }) => {
                 let d = direction.normalize_or(Vec3::Y);
                 let up = if d.y.abs() < 0.9 { Vec3::Y } else { Vec3::X };
-                let margin = radius * 0.01;
-                let eye = center + d * (radius + margin);
-                let matrix = glam::camera::rh::proj::directx::orthographic(
-                    -radius,
-                    radius,
-                    -radius,
-                    radius,
-                    0.0,
-                    2.0 * (radius + margin),
-                ) * glam::camera::rh::view::look_to_mat4(eye, -d, up);
+                // the map's footprint: the focus (or the whole scene); its depth range: the
+                // whole scene, so casters outside the footprint's box still shadow it
+                let (fc, fr) = settings.focus.map_or((center, radius), |(c, r)| (c, r.min(radius).max(1e-6)));
+                let reach = (fc - center).length() + radius;
+                let margin = reach * 0.01;
+                let eye = fc + d * (reach + margin);
+                let matrix =
+                    glam::camera::rh::proj::directx::orthographic(-fr, fr, -fr, fr, 0.0, 2.0 * (reach + margin))
+                        * glam::camera::rh::view::look_to_mat4(eye, -d, up);
                 let view = ShadowView {
                     matrix,
                     near: 0.0,
-                    far: 2.0 * radius,
+                    far: 2.0 * fr,
                     paraboloid: false,
                     resolution: res,
                     triangles_drawn: 0,
                 };
-                views.push((view, Box::new(|_: &Chunk| true)));
+                views.push((view, Box::new(|_: &Chunk| Class::Inside)));
             }
             (t, l) => return Err(GpuError::Failed(format!("a {t:?} shadow map does not fit a {l:?}"))),
         }
@@ -287,10 +361,11 @@ impl ShadowMapper {
                 | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
         });
-        let pipeline = match (technique, settings.rejection, &self.paraboloid_clip) {
-            (Technique::DualParaboloid, Rejection::ClipDistance, Some(p)) => p,
-            (Technique::DualParaboloid, _, _) => &self.paraboloid_discard,
-            _ => &self.matrix,
+        // (pipeline for chunks inside the view, pipeline for chunks across its edge)
+        let (inside, straddle) = match (technique, settings.rejection, &self.paraboloid_clip) {
+            (Technique::DualParaboloid, Rejection::ClipDistance, Some(p)) => (&self.paraboloid_plain, p),
+            (Technique::DualParaboloid, _, _) => (&self.paraboloid_plain, &self.paraboloid_discard),
+            _ => (&self.matrix, &self.matrix),
         };
         let layer_views: Vec<wgpu::TextureView> = (0..views.len() as u32)
             .map(|layer| {
@@ -312,14 +387,14 @@ impl ShadowMapper {
                 });
                 gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("shadow view"),
-                    layout: &pipeline.get_bind_group_layout(0),
+                    layout: &self.view_layout,
                     entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }],
                 })
             })
             .collect();
         let mut drawn = vec![0; views.len()];
         let (time, clock) = gpu.measure(|encoder| {
-            for (k, ((_, visible), bind)) in views.iter().zip(&binds).enumerate() {
+            for (k, ((_, classify), bind)) in views.iter().zip(&binds).enumerate() {
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("shadow depth"),
                     color_attachments: &[],
@@ -333,9 +408,11 @@ impl ShadowMapper {
                     }),
                     ..Default::default()
                 });
-                pass.set_pipeline(pipeline);
                 pass.set_bind_group(0, bind, &[]);
-                drawn[k] = geometry.draw(&mut pass, visible);
+                pass.set_pipeline(inside);
+                drawn[k] = geometry.draw(&mut pass, |c| classify(c) == Class::Inside);
+                pass.set_pipeline(straddle);
+                drawn[k] += geometry.draw(&mut pass, |c| classify(c) == Class::Straddle);
             }
         })?;
         let views =
