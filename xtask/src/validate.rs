@@ -178,7 +178,7 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
     let (gpu_image, gpu_unshadowed, gpu_s, shadow_ms) = gpu_render(&gpu, &scene, &map, &decomposition, &plan)?;
 
     stages.next("room: point-light shadow maps against ray-traced visibility, and their speed");
-    let (mask_rows, mask_images, clock) = room_masks(&gpu, &plan)?;
+    let (mask_rows, mask_images, size_rows, clock) = room_masks(&gpu, &plan)?;
 
     stages.next("metrics");
     let tm = FlipTonemap::for_reference(&reference.color);
@@ -256,6 +256,7 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
         rows: &rows,
         masks: &mask_rows,
         mask_images: &mask_images,
+        sizes: &size_rows,
         clock,
         tm: &tm,
         size: (w, h),
@@ -273,6 +274,14 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
     }
     for m in &mask_rows {
         println!("  room {:<26} {:>7.3} % of pixels disagree  {:>7.2} ms", m.name, m.disagreement * 100.0, m.gpu_ms);
+    }
+    for r in &size_rows {
+        println!(
+            "  room paraboloid_1024, widest edge {:.3} rad ({} triangles): {:.3} % disagree",
+            r.widest,
+            r.triangles,
+            r.disagreement * 100.0
+        );
     }
     println!("report: {}", path.display());
     if checked == 0 {
@@ -353,7 +362,7 @@ fn gpu_render(
 
 type MaskImages = (Vec<f32>, Vec<f32>, Vec<Option<bool>>, (u32, u32));
 
-fn room_masks(gpu: &Gpu, plan: &Plan) -> Result<(Vec<MaskRow>, MaskImages, gpu::Clock), String> {
+fn room_masks(gpu: &Gpu, plan: &Plan) -> Result<(Vec<MaskRow>, MaskImages, Vec<SizeRow>, gpu::Clock), String> {
     let e = |e: gpu::GpuError| e.to_string();
     let mut scene = scene::Scene::builtin("room").map_err(|e| e.to_string())?;
     (scene.camera.width, scene.camera.height) = plan.room_size;
@@ -401,7 +410,26 @@ fn room_masks(gpu: &Gpu, plan: &Plan) -> Result<(Vec<MaskRow>, MaskImages, gpu::
             triangles: m.triangles_drawn(),
         });
     }
-    Ok((rows, images, clock))
+    // the paper's caveat: error against the angle triangles span from the light
+    let mut sizes = Vec::new();
+    for angle in [None, Some(0.8), Some(0.4), Some(0.2), Some(0.1), Some(0.05)] {
+        let settings = ShadowSettings { subdivide_angle: angle, ..ShadowSettings::default() };
+        let t = shadow_triangles(&tris, &light, Technique::DualParaboloid, &settings);
+        let widest = shadowmap_paraboloid::subdivide::max_edge_angle(&t, position);
+        let g = ShadowGeometry::upload(gpu, &t, ShadowGeometry::CHUNK_TRIANGLES).map_err(e)?;
+        let m = mapper.render(gpu, &g, &light, Technique::DualParaboloid, &settings).map_err(e)?;
+        mapper.visibility(gpu, &m, &gb, &vis.layer(0)).map_err(e)?;
+        let (frac, _) = disagreement(&vis.read(gpu, 0).map_err(e)?, &truth);
+        sizes.push(SizeRow { widest, triangles: t.len(), disagreement: frac });
+    }
+    Ok((rows, images, sizes, clock))
+}
+
+/// One row of the error-against-triangle-size sweep.
+struct SizeRow {
+    widest: f32,
+    triangles: usize,
+    disagreement: f64,
 }
 
 struct Report<'a> {
@@ -412,6 +440,7 @@ struct Report<'a> {
     rows: &'a [Row],
     masks: &'a [MaskRow],
     mask_images: &'a MaskImages,
+    sizes: &'a [SizeRow],
     clock: gpu::Clock,
     tm: &'a FlipTonemap,
     size: (u32, u32),
@@ -558,6 +587,16 @@ impl Report<'_> {
                 m.triangles,
                 m.disagreement * 100.0,
                 m.gpu_ms
+            );
+        }
+        s.push_str("</table><h3>Error against triangle size</h3><p>Dual paraboloid 1024², clip distances: triangles bisected until no edge spans more than the angle from the light (the paper's caveat: rasterization interpolates the non-linear mapping linearly).</p><table><tr><th>widest edge from the light</th><th>triangles</th><th>pixels that disagree</th></tr>");
+        for r in self.sizes {
+            let _ = write!(
+                s,
+                "<tr><td>{:.3} rad</td><td>{}</td><td>{:.3} %</td></tr>",
+                r.widest,
+                r.triangles,
+                r.disagreement * 100.0
             );
         }
         s.push_str("</table><p>Masks: dual paraboloid 1024² (clip distances, subdivided), cube 592², and where each disagrees with the ray-traced truth (red: lit but should be shadowed, blue: shadowed but lit).</p><div class=\"grid\">");

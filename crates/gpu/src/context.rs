@@ -56,7 +56,19 @@ impl Gpu {
     /// # Errors
     /// [`GpuError::NoAdapter`] naming `mesa-vulkan-drivers` when there is no adapter.
     pub fn new() -> Result<Self, GpuError> {
-        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        Self::with_backends(None)
+    }
+
+    /// As [`Gpu::new`], restricted to `backends` (`None`: wgpu's default, or `WGPU_BACKEND`).
+    ///
+    /// # Errors
+    /// [`GpuError::NoAdapter`] when none of them has an adapter.
+    pub fn with_backends(backends: Option<wgpu::Backends>) -> Result<Self, GpuError> {
+        let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        if let Some(b) = backends {
+            descriptor.backends = b;
+        }
+        let instance = wgpu::Instance::new(descriptor);
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions::default()))
             .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
         let info = adapter.get_info();

@@ -155,6 +155,12 @@ fn point_light_over_a_lambertian_plane_matches_the_closed_form() {
 }
 
 #[test]
+fn no_adapter_is_an_error_naming_the_driver_package() {
+    let err = Gpu::with_backends(Some(wgpu::Backends::empty())).err().expect("no backend, no adapter");
+    assert!(err.to_string().contains("mesa-vulkan-drivers"), "{err}");
+}
+
+#[test]
 fn adapter_is_described_and_sizes_beyond_the_limits_are_refused() {
     let gpu = gpu();
     assert!(!gpu.describe().is_empty());

@@ -16,6 +16,12 @@ fn angle(light: Vec3, a: Vec3, b: Vec3) -> f32 {
     da.cross(db).length().atan2(da.dot(db))
 }
 
+/// The widest angle any triangle edge of `triangles` spans seen from `light`, radians.
+#[must_use]
+pub fn max_edge_angle(triangles: &[[Vec3; 3]], light: Vec3) -> f32 {
+    triangles.iter().flat_map(|t| [0, 1, 2].map(|k| angle(light, t[k], t[(k + 1) % 3]))).fold(0.0, f32::max)
+}
+
 /// `triangles` with every triangle bisected until each edge subtends at most `max_angle`
 /// radians from `light` (or [`MAX_SPLITS`] levels deep).
 #[must_use]

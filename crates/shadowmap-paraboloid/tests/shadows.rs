@@ -270,3 +270,19 @@ fn mismatched_technique_and_light_is_an_error() {
         .expect("refused");
     assert!(err.to_string().contains("does not fit"), "{err}");
 }
+
+#[test]
+fn pcf_softens_only_the_shadow_edges() {
+    let s = Setup::new(room(320, 240));
+    let tris = scene_triangles(&s.scene);
+    let light = ShadowLight::omni(s.scene.point_lights[0].position);
+    let hard = s.mask(&s.map(&tris, &light, Technique::DualParaboloid, &ShadowSettings::default()));
+    let pcf = ShadowSettings { pcf_radius: 2, ..ShadowSettings::default() };
+    let soft = s.mask(&s.map(&tris, &light, Technique::DualParaboloid, &pcf));
+    let partial = soft.iter().filter(|v| **v > 0.02 && **v < 0.98).count();
+    assert!(partial > 100, "{partial} fractional pixels: PCF did not filter");
+    // away from edges PCF agrees with the hard test; the two differ on few pixels
+    let flipped = hard.iter().zip(&soft).filter(|(h, v)| (**h > 0.5) != (**v > 0.5)).count();
+    assert!(flipped * 100 < hard.len(), "{flipped} pixels changed side");
+    assert!(partial * 10 < hard.len(), "{partial} fractional pixels: more than the edges");
+}
