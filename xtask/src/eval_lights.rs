@@ -6,7 +6,8 @@
 
 use crate::render::load_map;
 use light_extract::{
-    CenterSurround, EmissiveSplit, ImportanceSampled, LightExtractor, MedianCut, VarianceMinimization, interleaved_sets,
+    AboveHorizon, CenterSurround, EmissiveSplit, ImportanceSampled, LightExtractor, MedianCut, VarianceMinimization,
+    interleaved_sets,
 };
 use ref_tracer::metrics::{FlipTonemap, flip, rmse};
 use ref_tracer::{EnvLight, Integrator, LightSet, RenderSettings, SceneBvh, Strategy};
@@ -45,6 +46,9 @@ fn methods(k: usize) -> Vec<(String, Box<dyn LightExtractor>)> {
         ("emissive-split/no-masking".into(), Box::new(EmissiveSplit { masking: false, ..es })),
         ("emissive-split/no-kmeans".into(), Box::new(EmissiveSplit { kmeans: false, ..es })),
         ("emissive-split/neither".into(), Box::new(EmissiveSplit { masking: false, kmeans: false, ..es })),
+        // ours, not the papers': only the hemisphere above the ground reaches the receivers
+        ("emissive-split+above-horizon".into(), Box::new(AboveHorizon::new(es))),
+        ("median-cut+above-horizon".into(), Box::new(AboveHorizon::new(MedianCut::with_lights(k)))),
     ]
 }
 

@@ -2,7 +2,8 @@
 //! lights + ambient and write lights.json, ambient.exr, lights.gltf and overlay.png.
 
 use light_extract::{
-    CenterSurround, EmissiveSplit, ImportanceSampled, LightExtractor, MedianCut, VarianceMinimization, interleaved_sets,
+    AboveHorizon, CenterSurround, EmissiveSplit, ImportanceSampled, LightExtractor, MedianCut, VarianceMinimization,
+    interleaved_sets,
 };
 use std::path::Path;
 
@@ -11,14 +12,23 @@ pub const METHODS: [&str; 5] = ["emissive-split", "center-surround", "median-cut
 
 pub fn run(path: &Path, method: &str, k: usize, out: Option<&Path>, lux_per_unit: f32) -> Result<(), String> {
     let map = envmap_sphere::EnvMap::load(path).map_err(|e| e.to_string())?;
-    let extractor: Box<dyn LightExtractor> = match method {
+    // any method + "+above-horizon": only the hemisphere above the ground (see AboveHorizon)
+    let (base, above_horizon) = method.strip_suffix("+above-horizon").map_or((method, false), |b| (b, true));
+    let extractor: Box<dyn LightExtractor> = match base {
         "emissive-split" => Box::new(EmissiveSplit { lights: k, ..EmissiveSplit::default() }),
         "center-surround" => Box::new(CenterSurround { max_lights: k, ..CenterSurround::default() }),
         "median-cut" => Box::new(MedianCut::with_lights(k)),
         "variance-min" => Box::new(VarianceMinimization::with_lights(k)),
         "importance" => Box::new(ImportanceSampled { count: k, seed: 0 }),
-        other => return Err(format!("unknown method {other:?}; available: {}", METHODS.join(", "))),
+        other => {
+            return Err(format!(
+                "unknown method {other:?}; available: {}, each optionally with +above-horizon",
+                METHODS.join(", ")
+            ));
+        }
     };
+    let extractor: Box<dyn LightExtractor> =
+        if above_horizon { Box::new(AboveHorizon::new(extractor)) } else { extractor };
     let d = extractor.extract(&map).map_err(|e| format!("{}: {e}", path.display()))?;
     let stem = path.file_stem().map_or_else(|| "map".into(), |s| s.to_string_lossy().to_string());
     let dir = out.map_or_else(|| Path::new("target/extract").join(format!("{stem}-{method}")), Path::to_path_buf);

@@ -53,7 +53,8 @@ enum Command {
         /// The map (.exr or .hdr).
         path: PathBuf,
         /// emissive-split, center-surround (stops by Weber's law; K is a cap), median-cut,
-        /// variance-min or importance.
+        /// variance-min or importance; append +above-horizon to model only the hemisphere above
+        /// the ground (for scenes standing on an opaque ground).
         #[arg(long, default_value = "median-cut")]
         method: String,
         /// Number of lights K (median cut uses the largest power of two not above K).

@@ -136,3 +136,9 @@ pub trait LightExtractor {
     /// [`ExtractError::Parameter`] when a parameter is out of range.
     fn extract(&self, map: &EnvMap) -> Result<Decomposition, ExtractError>;
 }
+
+impl<T: LightExtractor + ?Sized> LightExtractor for Box<T> {
+    fn extract(&self, map: &EnvMap) -> Result<Decomposition, ExtractError> {
+        (**self).extract(map)
+    }
+}

@@ -14,6 +14,9 @@
 //! - [`EmissiveSplit`] (paper 001): emissive texels -> EnvDirects (importance sampling, masking,
 //!   k-means), the rest -> EnvIndirects (an illumination cut over a binary light tree).
 //!
+//! [`AboveHorizon`] wraps any of them (our option, not a paper's): for scenes on an opaque
+//! ground it models only the hemisphere that can reach the receivers.
+//!
 //! Outputs: [`Decomposition::to_json`] (`lights.json`), [`Decomposition::to_gltf`] (glTF 2.0 with
 //! `KHR_lights_punctual` directional lights), the remainder map (`ambient.exr`) and an overlay of
 //! the lights on the map ([`overlay`]).
@@ -28,6 +31,7 @@
 //!
 //! Architecture invariant: knows lights, never wgpu.
 
+mod above_horizon;
 mod center_surround;
 mod decomposition;
 mod emissive_split;
@@ -38,6 +42,7 @@ pub mod overlay;
 mod regions;
 mod variance;
 
+pub use above_horizon::{AboveHorizon, upper_hemisphere};
 pub use center_surround::CenterSurround;
 pub use decomposition::{Decomposition, ExtractError, ExtractedLight, LightExtractor, interleaved_sets};
 pub use emissive_split::EmissiveSplit;

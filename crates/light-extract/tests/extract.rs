@@ -411,3 +411,34 @@ fn emissive_split_finds_one_sun_across_the_seam() {
     let sun_power = 2.0 * 20_000.0 * map.texel_solid_angle(100);
     assert!((f64::from(sun.power().x) / sun_power - 1.0).abs() < 1e-3);
 }
+
+#[test]
+fn above_horizon_drops_only_the_lower_hemisphere() {
+    use light_extract::{AboveHorizon, EmissiveSplit, MedianCut};
+    // a sun below the horizon and a sky above: the wrapped methods see only the sky
+    let map = EnvMap::from_fn(256, 128, |d| {
+        if d.dot(Vec3::new(0.3, -0.8, 0.2).normalize()) > 0.995 {
+            Vec3::splat(5000.0)
+        } else if d.y > 0.0 {
+            Vec3::new(0.4, 0.5, 0.9)
+        } else {
+            Vec3::splat(0.2)
+        }
+    });
+    for d in [
+        AboveHorizon::new(MedianCut::with_lights(16)).extract(&map).unwrap(),
+        AboveHorizon::new(EmissiveSplit { lights: 16, ..EmissiveSplit::default() }).extract(&map).unwrap(),
+    ] {
+        assert!(d.method.ends_with("+above-horizon"), "{}", d.method);
+        assert!(d.lights.iter().all(|l| l.light.direction.y > -0.05), "{}: a light below the horizon", d.method);
+        // the books balance over the upper hemisphere
+        assert!(d.power_balance_error() < 1e-4, "{}: {}", d.method, d.power_balance_error());
+        let dropped = d.params["dropped_power"][1].as_f64().unwrap();
+        assert!(dropped > 1.0, "{}: the sun's power is dropped: {dropped}", d.method);
+        // nothing of the lower hemisphere is left in the ambient term
+        assert!(d.ambient.pixels().iter().zip(0..).all(|(p, k)| {
+            let (i, j) = (k % 256, k / 256);
+            d.ambient.texel_dir(i, j).y >= 0.0 || *p == Vec3::ZERO
+        }));
+    }
+}
