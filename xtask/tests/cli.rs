@@ -263,13 +263,20 @@ fn eval_lights_writes_both_tables_with_a_noise_floor() {
     let csv = std::fs::read_to_string(out_dir.join("eval-lights.csv")).expect("csv");
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines[0], "map,scene,method,lights,rmse,flip,extract_ms");
-    assert_eq!(lines.len(), 1 + 9, "floor + five methods + three ablations: {csv}");
+    assert_eq!(lines.len(), 1 + 11, "floor + five methods + three ablations + two above-horizon: {csv}");
     for ablation in ["emissive-split/no-masking", "emissive-split/no-kmeans", "emissive-split/neither"] {
         assert!(csv.contains(&format!(",{ablation},")), "{ablation} missing:\n{csv}");
     }
-    for method in
-        ["emissive-split", "center-surround", "median-cut", "variance-min", "importance", "(reference, other seed)"]
-    {
+    for method in [
+        "emissive-split",
+        "center-surround",
+        "median-cut",
+        "variance-min",
+        "importance",
+        "(reference, other seed)",
+        "emissive-split+above-horizon",
+        "median-cut+above-horizon",
+    ] {
         assert!(csv.contains(&format!(",{method},")), "{method} missing:\n{csv}");
     }
     let md = std::fs::read_to_string(out_dir.join("eval-lights.md")).expect("md");
