@@ -1,5 +1,5 @@
 //! Every WGSL file under `shaders/` parses and validates with naga, composed with the library
-//! files its `// requires:` lines name (as `gpu::shader::compose` does at run time). Each shader
+//! files its `// requires:` lines name, by `gpu::shader::compose_with` as at run time. Each shader
 //! sits in `shaders/<crate>/` of the crate whose pass owns it.
 
 use std::path::{Path, PathBuf};
@@ -12,24 +12,15 @@ fn shaders() -> Vec<PathBuf> {
     out
 }
 
+/// The file composed as at run time (`gpu::shader::compose_with`), its library files read from
+/// `shaders/`.
 fn compose(path: &Path) -> Result<String, String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let requires: Vec<String> = text
-        .lines()
-        .filter(|l| !l.trim_start().starts_with("enable "))
-        .map_while(|l| l.trim().strip_prefix("//").map(str::trim))
-        .filter_map(|l| l.strip_prefix("requires:"))
-        .flat_map(str::split_whitespace)
-        .map(String::from)
-        .collect();
-    let (enables, body): (Vec<&str>, Vec<&str>) = text.lines().partition(|l| l.trim_start().starts_with("enable "));
-    let mut out = enables.join("\n") + "\n";
-    for r in requires {
-        let lib = workspace_root().join("shaders").join(&r);
-        out += &std::fs::read_to_string(&lib).map_err(|e| format!("{} requires {r}: {e}", path.display()))?;
-        out.push('\n');
-    }
-    Ok(out + &body.join("\n"))
+    let read = |name: &str| {
+        let lib = workspace_root().join("shaders").join(name);
+        std::fs::read_to_string(&lib).map_err(|e| format!("{} requires {name}: {e}", path.display()))
+    };
+    gpu::shader::compose_with(&text, read)
 }
 
 #[test]

@@ -29,12 +29,8 @@ pub fn run(extra: &[String]) -> Result<(), String> {
     }
     if extra.is_empty() {
         println!("xtask test: cargo xtask validate --quick");
-        crate::validate::run(&crate::validate::ValidateArgs {
-            envmap: None,
-            scene: "spheres_box".into(),
-            quick: true,
-            out: "target/validate".into(),
-        })?;
+        // the command's own defaults, as a user gets them
+        crate::validate::run(&clap::Parser::parse_from(["validate", "--quick"]))?;
     }
     println!("xtask test: all passed in {:.0} s", start.elapsed().as_secs_f64());
     Ok(())

@@ -8,7 +8,9 @@
 use crate::render::load_map;
 use envmap_sphere::{EnvMap, Tonemap};
 use glam::Vec3;
-use gpu::{GBuffer, Gpu, SceneGeometry, ShadeLight, ShadeParams, ShadingPass, ShadowGeometry, Visibility};
+use gpu::{
+    Background, GBufferPass, Gpu, SceneGeometry, ShadeLight, ShadeParams, ShadingPass, ShadowGeometry, Visibility,
+};
 use light_extract::{EmissiveSplit, LightExtractor, interleaved_sets};
 use ref_tracer::metrics::{FlipTonemap, flip, rmse};
 use ref_tracer::visibility::{VisibilityLight, light_visibility};
@@ -22,7 +24,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Options of `cargo xtask validate`.
-#[derive(clap::Args, Clone, Debug)]
+#[derive(clap::Parser, Clone, Debug)]
 pub struct ValidateArgs {
     /// Environment map (.exr or .hdr); the embedded default map when absent.
     #[arg(long)]
@@ -30,7 +32,7 @@ pub struct ValidateArgs {
     /// Built-in scene lit by the map.
     #[arg(long, default_value = "spheres_box")]
     pub scene: String,
-    /// Smaller images and fewer samples: about two minutes on 2 cores.
+    /// Smaller images and fewer samples: about 10 s on 2 cores once built.
     #[arg(long)]
     pub quick: bool,
     /// Output directory.
@@ -175,10 +177,11 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
     stages.next("GPU: G-buffer, orthographic shadow maps, shading (lavapipe)");
     crate::lavapipe::ensure()?;
     let gpu = Gpu::new().map_err(|e| e.to_string())?;
-    let (gpu_image, gpu_unshadowed, gpu_s, shadow_ms) = gpu_render(&gpu, &scene, &map, &decomposition, &plan)?;
+    let passes = Passes { gbuffer: GBufferPass::new(&gpu), shadows: ShadowMapper::new(&gpu) };
+    let (gpu_image, gpu_unshadowed, gpu_s, shadow_ms) = gpu_render(&gpu, &passes, &scene, &map, &decomposition, &plan)?;
 
     stages.next("room: point-light shadow maps against ray-traced visibility, and their speed");
-    let (mask_rows, mask_images, size_rows, clock) = room_masks(&gpu, &plan)?;
+    let (mask_rows, mask_images, size_rows, clock) = room_masks(&gpu, &passes, &plan)?;
 
     stages.next("metrics");
     let tm = FlipTonemap::for_reference(&reference.color);
@@ -311,8 +314,8 @@ fn load_thresholds() -> Result<BTreeMap<String, f64>, String> {
 
 /// Sphere around what the camera sees: the mean visible position and the 95th percentile of
 /// distances to it (the rest, far away, is left unshadowed).
-fn view_focus(positions: &[[f32; 4]]) -> Option<(Vec3, f32)> {
-    let pts: Vec<Vec3> = positions.iter().filter(|p| p[3] >= 0.0).map(|p| Vec3::new(p[0], p[1], p[2])).collect();
+fn view_focus(points: &[(Vec3, Vec3)]) -> Option<(Vec3, f32)> {
+    let pts: Vec<Vec3> = points.iter().map(|(p, _)| *p).filter(|p| p.is_finite()).collect();
     if pts.is_empty() {
         return None;
     }
@@ -324,8 +327,15 @@ fn view_focus(positions: &[[f32; 4]]) -> Option<(Vec3, f32)> {
 
 type GpuImages = (Vec<Vec3>, Vec<Vec3>, f64, f64);
 
+/// The GPU passes, built once per run.
+struct Passes {
+    gbuffer: GBufferPass,
+    shadows: ShadowMapper,
+}
+
 fn gpu_render(
     gpu: &Gpu,
+    passes: &Passes,
     scene: &scene::Scene,
     map: &EnvMap,
     d: &light_extract::Decomposition,
@@ -334,25 +344,30 @@ fn gpu_render(
     let e = |e: gpu::GpuError| e.to_string();
     let start = Instant::now();
     let geometry = SceneGeometry::upload(gpu, scene).map_err(e)?;
-    let gb = GBuffer::render(gpu, &geometry, &scene.camera).map_err(e)?;
+    let gb = passes.gbuffer.render(gpu, &geometry, &scene.camera).map_err(e)?;
+    let points = gb.read_points(gpu).map_err(e)?;
     let tris = gpu::scene_triangles(scene);
     let shadow_geometry = ShadowGeometry::upload(gpu, &tris, ShadowGeometry::CHUNK_TRIANGLES).map_err(e)?;
-    let mapper = ShadowMapper::new(gpu);
-    let settings = ShadowSettings { focus: view_focus(&gb.read_positions(gpu).map_err(e)?), ..plan.shadow };
+    let mapper = &passes.shadows;
+    let settings = ShadowSettings { focus: view_focus(&points), ..plan.shadow };
     let lights: Vec<ShadeLight> = d.lights.iter().map(|l| ShadeLight::from(&l.light)).collect();
     let (w, h) = gb.size();
     let vis = Visibility::new(gpu, w, h, lights.len() as u32).map_err(e)?;
     let mut shadow_ms = 0.0;
     for (k, l) in d.lights.iter().enumerate() {
-        // model only what the scene requires: a light below the horizon of every receiver
-        // would be skipped by the shading pass anyway; its map still costs little here
+        // model only what the scene requires: a light that no visible surface faces lights
+        // nothing (the shading pass skips it per pixel), so it needs no shadow map
+        if !points.iter().any(|(p, n)| p.is_finite() && n.dot(l.light.direction) > 0.0) {
+            continue;
+        }
         let light = ShadowLight::Distant { direction: l.light.direction };
         let m = mapper.render(gpu, &shadow_geometry, &light, Technique::Orthographic, &settings).map_err(e)?;
         shadow_ms += m.time.as_secs_f64() * 1e3;
         mapper.visibility(gpu, &m, &gb, &vis.layer(k as u32)).map_err(e)?;
     }
-    let pass = ShadingPass::new(gpu);
-    let params = ShadeParams { lights: &lights, ambient: Some(&d.ambient_sh), background: Some(map) };
+    let pass = ShadingPass::new(gpu).map_err(e)?;
+    let background = Background::upload(gpu, map).map_err(e)?;
+    let params = ShadeParams { lights: &lights, ambient: Some(&d.ambient_sh), background: Some(&background) };
     let image = pass.render(gpu, &geometry, &gb, &params, &vis).map_err(e)?;
     let seconds = start.elapsed().as_secs_f64();
     let lit = Visibility::new(gpu, w, h, lights.len() as u32).map_err(e)?;
@@ -362,22 +377,26 @@ fn gpu_render(
 
 type MaskImages = (Vec<f32>, Vec<f32>, Vec<Option<bool>>, (u32, u32));
 
-fn room_masks(gpu: &Gpu, plan: &Plan) -> Result<(Vec<MaskRow>, MaskImages, Vec<SizeRow>, gpu::Clock), String> {
+fn room_masks(
+    gpu: &Gpu,
+    passes: &Passes,
+    plan: &Plan,
+) -> Result<(Vec<MaskRow>, MaskImages, Vec<SizeRow>, gpu::Clock), String> {
     let e = |e: gpu::GpuError| e.to_string();
     let mut scene = scene::Scene::builtin("room").map_err(|e| e.to_string())?;
     (scene.camera.width, scene.camera.height) = plan.room_size;
     let geometry = SceneGeometry::upload(gpu, &scene).map_err(e)?;
-    let gb = GBuffer::render(gpu, &geometry, &scene.camera).map_err(e)?;
+    let gb = passes.gbuffer.render(gpu, &geometry, &scene.camera).map_err(e)?;
     let points = gb.read_points(gpu).map_err(e)?;
     let position = scene.point_lights[0].position;
     let truth = light_visibility(&SceneBvh::new(&scene), &points, VisibilityLight::Point(position));
     let tris = gpu::scene_triangles(&scene);
     let light = ShadowLight::omni(position);
-    let mapper = ShadowMapper::new(gpu);
+    let mapper = &passes.shadows;
     let (w, h) = plan.room_size;
     let vis = Visibility::new(gpu, w, h, 1).map_err(e)?;
     let mut rows = Vec::new();
-    let mut images = (Vec::new(), Vec::new(), truth.clone(), plan.room_size);
+    let (mut paraboloid_mask, mut cube_mask) = (Vec::new(), Vec::new());
     let mut clock = gpu::Clock::WallTime;
     for v in equal_texel_variants() {
         let (technique, settings) = (v.technique, v.settings);
@@ -397,9 +416,9 @@ fn room_masks(gpu: &Gpu, plan: &Plan) -> Result<(Vec<MaskRow>, MaskImages, Vec<S
         let mask = vis.read(gpu, 0).map_err(e)?;
         let (frac, _) = disagreement(&mask, &truth);
         if v.name == "paraboloid_1024_clip_subdivided" {
-            images.0 = mask.clone();
+            paraboloid_mask = mask;
         } else if v.name == "cube_592" {
-            images.1 = mask;
+            cube_mask = mask;
         }
         rows.push(MaskRow {
             name: v.name,
@@ -422,7 +441,7 @@ fn room_masks(gpu: &Gpu, plan: &Plan) -> Result<(Vec<MaskRow>, MaskImages, Vec<S
         let (frac, _) = disagreement(&vis.read(gpu, 0).map_err(e)?, &truth);
         sizes.push(SizeRow { widest, triangles: t.len(), disagreement: frac });
     }
-    Ok((rows, images, sizes, clock))
+    Ok((rows, (paraboloid_mask, cube_mask, truth, plan.room_size), sizes, clock))
 }
 
 /// One row of the error-against-triangle-size sweep.
@@ -488,11 +507,12 @@ fn truth_diff_bytes(mask: &[f32], truth: &[Option<bool>]) -> Vec<u8> {
 }
 
 impl Report<'_> {
+    /// Writes `name.png` into `dir` and returns an `<img>` embedding the same bytes.
     fn png(&self, dir: &Path, name: &str, (w, h): (u32, u32), bytes: &[u8]) -> Result<String, String> {
+        let png = envmap_sphere::io::encode_png_srgb8(w, h, bytes).map_err(|e| format!("{name}.png: {e}"))?;
         let path = dir.join(format!("{name}.png"));
-        envmap_sphere::io::save_png_srgb8(&path, w, h, bytes).map_err(|e| e.to_string())?;
-        let data = std::fs::read(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-        Ok(format!("<img alt=\"{name}\" src=\"data:image/png;base64,{}\">", base64(&data)))
+        std::fs::write(&path, &png).map_err(|e| format!("{}: {e}", path.display()))?;
+        Ok(format!("<img alt=\"{name}\" src=\"data:image/png;base64,{}\">", base64(&png)))
     }
 
     fn html(&self, dir: &Path) -> Result<String, String> {

@@ -223,8 +223,25 @@ pub fn save_png_rgb(
 /// # Errors
 /// [`EnvMapError::Encode`] when the file cannot be written or the buffer does not match the size.
 pub fn save_png_srgb8(path: &Path, width: u32, height: u32, bytes: &[u8]) -> Result<(), EnvMapError> {
-    image::save_buffer_with_format(path, bytes, width, height, image::ExtendedColorType::Rgb8, image::ImageFormat::Png)
-        .map_err(|e| EnvMapError::Encode { path: path.to_path_buf(), format: "PNG", reason: e.to_string() })
+    let png = encode_png_srgb8(width, height, bytes).map_err(|e| match e {
+        EnvMapError::Encode { format, reason, .. } => EnvMapError::Encode { path: path.to_path_buf(), format, reason },
+        other => other,
+    })?;
+    std::fs::write(path, png).map_err(|e| EnvMapError::io(path, e))
+}
+
+/// Encodes row-major 8-bit sRGB triples as PNG file bytes in memory (for embedding, e.g. in an
+/// HTML report). Errors name no file.
+///
+/// # Errors
+/// [`EnvMapError::Encode`] when the buffer does not match the size.
+pub fn encode_png_srgb8(width: u32, height: u32, bytes: &[u8]) -> Result<Vec<u8>, EnvMapError> {
+    use image::ImageEncoder;
+    let mut png = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut png)
+        .write_image(bytes, width, height, image::ExtendedColorType::Rgb8)
+        .map_err(|e| EnvMapError::Encode { path: "(in memory)".into(), format: "PNG", reason: e.to_string() })?;
+    Ok(png)
 }
 
 type Decoded = (u32, u32, Vec<Vec3>, FileFormat, String);

@@ -73,12 +73,14 @@ impl Sh9 {
     /// Irradiance for unit normal `n`: sum A_l c_k Y_k(n) (Ramamoorthy and Hanrahan).
     #[must_use]
     pub fn irradiance(&self, n: Vec3) -> Vec3 {
-        sh9_basis(n)
-            .iter()
-            .zip(&self.coeffs)
-            .enumerate()
-            .map(|(k, (b, c))| *c * (*b * IRRADIANCE_BAND_FACTORS[BAND[k]]))
-            .sum()
+        sh9_basis(n).iter().zip(self.irradiance_coefficients()).map(|(b, c)| c * *b).sum()
+    }
+
+    /// The coefficients of the irradiance function, A_l c_k: irradiance(n) = sum of these times
+    /// Y_k(n). Renderers upload these (the GPU shading pass does).
+    #[must_use]
+    pub fn irradiance_coefficients(&self) -> [Vec3; 9] {
+        std::array::from_fn(|k| self.coeffs[k] * IRRADIANCE_BAND_FACTORS[BAND[k]])
     }
 
     /// A map whose texels hold this function at their centres (a band-limited test map).

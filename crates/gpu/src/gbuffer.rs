@@ -34,21 +34,6 @@ pub fn view_projection(camera: &scene::Camera, near: f32, far: f32) -> Mat4 {
         * glam::camera::rh::view::look_to_mat4(camera.eye, forward, up)
 }
 
-fn target(gpu: &Gpu, camera: &scene::Camera, label: &str, format: wgpu::TextureFormat) -> wgpu::Texture {
-    gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d { width: camera.width, height: camera.height, depth_or_array_layers: 1 },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-            | wgpu::TextureUsages::TEXTURE_BINDING
-            | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
-    })
-}
-
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct CameraUniform {
@@ -56,34 +41,15 @@ struct CameraUniform {
     eye: [f32; 4],
 }
 
-impl GBuffer {
-    /// Renders the G-buffer of `geometry` seen by `camera`.
-    ///
-    /// # Errors
-    /// [`GpuError::TooLarge`] for an image beyond the adapter's limits; GPU failures.
-    pub fn render(gpu: &Gpu, geometry: &SceneGeometry, camera: &scene::Camera) -> Result<Self, GpuError> {
-        gpu.check_texture(camera.width, camera.height, 1)?;
-        let gb = Self {
-            position: target(gpu, camera, "gbuffer position", GBUFFER_FORMAT),
-            normal: target(gpu, camera, "gbuffer normal", GBUFFER_FORMAT),
-            geometric_normal: target(gpu, camera, "gbuffer geometric normal", GBUFFER_FORMAT),
-            depth: target(gpu, camera, "gbuffer depth", wgpu::TextureFormat::Depth32Float),
-            camera: *camera,
-        };
-        // Near and far planes bracket the scene's bounds as seen from the eye.
-        let (lo, hi) = geometry.bounds;
-        let reach = if lo.is_finite() { (hi - lo).length() + camera.eye.distance(0.5 * (lo + hi)) } else { 1.0 };
-        let far = reach.max(1e-3) * 1.01;
-        let near = (far * 1e-5).max(1e-4);
-        let uniform = CameraUniform {
-            view_proj: view_projection(camera, near, far).to_cols_array_2d(),
-            eye: Vec3::extend(camera.eye, 1.0).to_array(),
-        };
-        let buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("camera"),
-            contents: bytemuck::bytes_of(&uniform),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
+/// The G-buffer pass: its pipeline, built once, rendering a [`GBuffer`] per view.
+pub struct GBufferPass {
+    pipeline: wgpu::RenderPipeline,
+}
+
+impl GBufferPass {
+    /// Builds the pipeline.
+    #[must_use]
+    pub fn new(gpu: &Gpu) -> Self {
         let module =
             crate::shader::module(&gpu.device, "gbuffer", include_str!("../../../shaders/gpu/gbuffer.wgsl"), &[]);
         let targets: [Option<wgpu::ColorTargetState>; 3] = std::array::from_fn(|_| Some(GBUFFER_FORMAT.into()));
@@ -114,9 +80,40 @@ impl GBuffer {
             multiview_mask: None,
             cache: None,
         });
+        Self { pipeline }
+    }
+
+    /// Renders the G-buffer of `geometry` seen by `camera`.
+    ///
+    /// # Errors
+    /// [`GpuError::TooLarge`] for an image beyond the adapter's limits; GPU failures.
+    pub fn render(&self, gpu: &Gpu, geometry: &SceneGeometry, camera: &scene::Camera) -> Result<GBuffer, GpuError> {
+        let size = (camera.width, camera.height, 1);
+        let target = |label, format| crate::target::render_target(gpu, label, size, format);
+        let gb = GBuffer {
+            position: target("gbuffer position", GBUFFER_FORMAT)?,
+            normal: target("gbuffer normal", GBUFFER_FORMAT)?,
+            geometric_normal: target("gbuffer geometric normal", GBUFFER_FORMAT)?,
+            depth: target("gbuffer depth", wgpu::TextureFormat::Depth32Float)?,
+            camera: *camera,
+        };
+        // Near and far planes bracket the scene's bounds as seen from the eye.
+        let (lo, hi) = geometry.bounds;
+        let reach = if lo.is_finite() { (hi - lo).length() + camera.eye.distance(0.5 * (lo + hi)) } else { 1.0 };
+        let far = reach.max(1e-3) * 1.01;
+        let near = (far * 1e-5).max(1e-4);
+        let uniform = CameraUniform {
+            view_proj: view_projection(camera, near, far).to_cols_array_2d(),
+            eye: Vec3::extend(camera.eye, 1.0).to_array(),
+        };
+        let buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("camera"),
+            contents: bytemuck::bytes_of(&uniform),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
         let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gbuffer"),
-            layout: &pipeline.get_bind_group_layout(0),
+            layout: &self.pipeline.get_bind_group_layout(0),
             entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }],
         });
         let views = [&gb.position, &gb.normal, &gb.geometric_normal].map(|t| t.create_view(&Default::default()));
@@ -149,7 +146,7 @@ impl GBuffer {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(&pipeline);
+            pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &bind, &[]);
             pass.set_vertex_buffer(0, geometry.vertices.slice(..));
             pass.draw(0..geometry.vertex_count, 0..1);
@@ -157,7 +154,9 @@ impl GBuffer {
         gpu.submit_and_wait(encoder)?;
         Ok(gb)
     }
+}
 
+impl GBuffer {
     /// Image size.
     #[must_use]
     pub fn size(&self) -> (u32, u32) {

@@ -18,11 +18,13 @@ mod geometry;
 mod readback;
 mod shade;
 pub mod shader;
+mod target;
 mod timer;
 
 pub use context::{Gpu, GpuError};
-pub use gbuffer::{GBUFFER_FORMAT, GBuffer, view_projection};
+pub use gbuffer::{GBUFFER_FORMAT, GBuffer, GBufferPass, view_projection};
 pub use geometry::{Chunk, SceneGeometry, ShadowGeometry, scene_triangles};
 pub use readback::{read_texture_f32, read_texture_rgba};
-pub use shade::{HDR_FORMAT, ShadeLight, ShadeParams, ShadingPass, Visibility};
+pub use shade::{Background, HDR_FORMAT, ShadeLight, ShadeParams, ShadingPass, Visibility};
+pub use target::{layer_view, render_target};
 pub use timer::Clock;

@@ -52,34 +52,34 @@ fn read_layer_bytes(
     Ok(bytes.chunks_exact(padded as usize).flat_map(|r| r[..row as usize].to_vec()).collect())
 }
 
-/// Reads one layer of a single-channel 32-bit float texture (R32Float, or the depth aspect of
-/// Depth32Float / Depth32FloatStencil8), row-major from the top-left.
+/// Reads one layer of a single-channel texture as floats, row-major from the top-left: R32Float
+/// or the depth aspect of Depth32Float / Depth32FloatStencil8 as stored, R8Unorm in [0, 1].
 ///
 /// # Errors
 /// [`GpuError::Failed`] when the format cannot be read back or the copy fails.
 pub fn read_texture_f32(gpu: &Gpu, texture: &wgpu::Texture, layer: u32) -> Result<Vec<f32>, GpuError> {
-    let aspect = if texture.format().is_depth_stencil_format() {
-        wgpu::TextureAspect::DepthOnly
-    } else {
-        wgpu::TextureAspect::All
-    };
+    let format = texture.format();
+    let aspect =
+        if format.is_depth_stencil_format() { wgpu::TextureAspect::DepthOnly } else { wgpu::TextureAspect::All };
     let bytes = read_layer_bytes(gpu, texture, layer, aspect)?;
-    Ok(bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect())
+    match format.block_copy_size(Some(aspect)) {
+        Some(1) => Ok(bytes.iter().map(|&b| f32::from(b) / 255.0).collect()),
+        Some(4) => Ok(bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect()),
+        _ => Err(GpuError::Failed(format!("read_texture_f32: {format:?} is not a single-channel format"))),
+    }
 }
 
-/// Reads one layer of an Rgba32Float texture as RGBA quadruples, row-major from the top-left;
-/// an R8Unorm texture comes back as one float per texel in [0, 1].
+/// Reads one layer of an Rgba32Float texture as RGBA quadruples, row-major from the top-left.
 ///
 /// # Errors
 /// As [`read_texture_f32`].
 pub fn read_texture_rgba(gpu: &Gpu, texture: &wgpu::Texture, layer: u32) -> Result<Vec<[f32; 4]>, GpuError> {
-    let bytes = read_layer_bytes(gpu, texture, layer, wgpu::TextureAspect::All)?;
-    match texture.format() {
-        wgpu::TextureFormat::Rgba32Float => Ok(bytes
-            .chunks_exact(16)
-            .map(|b| std::array::from_fn(|c| f32::from_le_bytes([b[4 * c], b[4 * c + 1], b[4 * c + 2], b[4 * c + 3]])))
-            .collect()),
-        wgpu::TextureFormat::R8Unorm => Ok(bytes.iter().map(|&b| [f32::from(b) / 255.0, 0.0, 0.0, 0.0]).collect()),
-        f => Err(GpuError::Failed(format!("read_texture_rgba: unsupported format {f:?}"))),
+    if texture.format() != wgpu::TextureFormat::Rgba32Float {
+        return Err(GpuError::Failed(format!("read_texture_rgba: {:?} is not Rgba32Float", texture.format())));
     }
+    let bytes = read_layer_bytes(gpu, texture, layer, wgpu::TextureAspect::All)?;
+    Ok(bytes
+        .chunks_exact(16)
+        .map(|b| std::array::from_fn(|c| f32::from_le_bytes([b[4 * c], b[4 * c + 1], b[4 * c + 2], b[4 * c + 3]])))
+        .collect())
 }

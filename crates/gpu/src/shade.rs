@@ -4,6 +4,7 @@
 use crate::context::{Gpu, GpuError};
 use crate::gbuffer::GBuffer;
 use crate::geometry::SceneGeometry;
+use crate::target::layer_view;
 use envmap_sphere::{EnvMap, Sh9};
 use glam::Vec3;
 use wgpu::util::DeviceExt;
@@ -40,14 +41,14 @@ impl From<&scene::PointLight> for ShadeLight {
 }
 
 /// What lights a frame.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Default)]
 pub struct ShadeParams<'a> {
     /// The lights, in the order of the visibility layers.
     pub lights: &'a [ShadeLight],
     /// Ambient radiance as SH9 (its irradiance lights the diffuse lobe, unshadowed).
     pub ambient: Option<&'a Sh9>,
     /// What misses see; black without.
-    pub background: Option<&'a EnvMap>,
+    pub background: Option<&'a Background>,
 }
 
 /// One visibility layer per light, screen-sized, 1 = lit.
@@ -65,23 +66,10 @@ impl Visibility {
     /// # Errors
     /// [`GpuError::TooLarge`] beyond the adapter's limits.
     pub fn new(gpu: &Gpu, width: u32, height: u32, layers: u32) -> Result<Self, GpuError> {
-        let layers = layers.max(1);
-        gpu.check_texture(width, height, layers)?;
-        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("visibility"),
-            size: wgpu::Extent3d { width, height, depth_or_array_layers: layers },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: Self::FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+        let texture = crate::target::render_target(gpu, "visibility", (width, height, layers.max(1)), Self::FORMAT)?;
         let mut encoder = gpu.encoder("visibility clear");
-        for layer in 0..layers {
-            let view = Self::view_of(&texture, layer);
+        for layer in 0..texture.depth_or_array_layers() {
+            let view = layer_view(&texture, layer);
             encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("visibility clear"),
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -100,19 +88,10 @@ impl Visibility {
         Ok(Self { texture })
     }
 
-    fn view_of(texture: &wgpu::Texture, layer: u32) -> wgpu::TextureView {
-        texture.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2),
-            base_array_layer: layer,
-            array_layer_count: Some(1),
-            ..Default::default()
-        })
-    }
-
     /// A render-target view of one layer (for a shadow technique to write).
     #[must_use]
     pub fn layer(&self, layer: u32) -> wgpu::TextureView {
-        Self::view_of(&self.texture, layer)
+        layer_view(&self.texture, layer)
     }
 
     /// Number of layers.
@@ -126,7 +105,7 @@ impl Visibility {
     /// # Errors
     /// GPU failures.
     pub fn read(&self, gpu: &Gpu, layer: u32) -> Result<Vec<f32>, GpuError> {
-        Ok(crate::readback::read_texture_rgba(gpu, &self.texture, layer)?.into_iter().map(|v| v[0]).collect())
+        crate::readback::read_texture_f32(gpu, &self.texture, layer)
     }
 }
 
@@ -151,6 +130,8 @@ struct ShadeUniform {
 /// The shading pass: pipeline built once, run per frame.
 pub struct ShadingPass {
     pipeline: wgpu::RenderPipeline,
+    // bound when a frame has no background (the shader then returns black)
+    no_background: Background,
 }
 
 /// Output format of the shading pass: linear HDR radiance.
@@ -158,11 +139,13 @@ pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
 impl ShadingPass {
     /// Builds the pipeline.
-    #[must_use]
-    pub fn new(gpu: &Gpu) -> Self {
+    ///
+    /// # Errors
+    /// GPU failures.
+    pub fn new(gpu: &Gpu) -> Result<Self, GpuError> {
         let module = crate::shader::module(&gpu.device, "shade", include_str!("../../../shaders/gpu/shade.wgsl"), &[]);
         let pipeline = crate::fullscreen::pipeline(gpu, "shade", &module, HDR_FORMAT);
-        Self { pipeline }
+        Ok(Self { pipeline, no_background: Background::from_texels(gpu, (1, 1), &[[0.0; 4]])? })
     }
 
     /// Shades `gbuffer` and returns the linear HDR image, row-major from the top-left.
@@ -186,26 +169,12 @@ impl ShadingPass {
                 limit: visibility.layers().into(),
             });
         }
-        let output = gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("shaded"),
-            size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: HDR_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
-        let background = upload_background(gpu, params.background)?;
+        let output = crate::target::render_target(gpu, "shaded", (w, h, 1), HDR_FORMAT)?;
         let rays = gbuffer.camera.rays();
-        let mut sh = [[0.0f32; 4]; 9];
-        if let Some(ambient) = params.ambient {
-            const BAND: [usize; 9] = [0, 1, 1, 1, 2, 2, 2, 2, 2];
-            for (k, c) in ambient.coeffs.iter().enumerate() {
-                sh[k] = (*c * envmap_sphere::sh::IRRADIANCE_BAND_FACTORS[BAND[k]]).extend(0.0).to_array();
-            }
-        }
-        let (bw, bh) = params.background.map_or((0, 0), |m| (m.width(), m.height()));
+        let sh =
+            params.ambient.map_or([[0.0f32; 4]; 9], |a| a.irradiance_coefficients().map(|c| c.extend(0.0).to_array()));
+        let (bw, bh) = params.background.map_or((0, 0), |b| b.size);
+        let background = &params.background.unwrap_or(&self.no_background).texture;
         let uniform = ShadeUniform {
             eye: rays.eye.extend(1.0).to_array(),
             right: rays.right.extend(0.0).to_array(),
@@ -241,7 +210,7 @@ impl ShadingPass {
             contents: bytemuck::cast_slice(&lights),
             usage: wgpu::BufferUsages::STORAGE,
         });
-        let views = [&gbuffer.position, &gbuffer.normal, &gbuffer.geometric_normal, &background]
+        let views = [&gbuffer.position, &gbuffer.normal, &gbuffer.geometric_normal, background]
             .map(|t| t.create_view(&Default::default()));
         let vis_view = visibility.texture.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
@@ -268,24 +237,43 @@ impl ShadingPass {
     }
 }
 
-fn upload_background(gpu: &Gpu, map: Option<&EnvMap>) -> Result<wgpu::Texture, GpuError> {
-    let (w, h) = map.map_or((1, 1), |m| (m.width(), m.height()));
-    gpu.check_texture(w, h, 1)?;
-    let texels: Vec<[f32; 4]> =
-        map.map_or_else(|| vec![[0.0; 4]], |m| m.pixels().iter().map(|p| p.extend(1.0).to_array()).collect());
-    Ok(gpu.device.create_texture_with_data(
-        &gpu.queue,
-        &wgpu::TextureDescriptor {
-            label: Some("background"),
-            size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba32Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        },
-        wgpu::util::TextureDataOrder::LayerMajor,
-        bytemuck::cast_slice(&texels),
-    ))
+/// An environment map on the GPU, as what camera rays that miss see: uploaded once, shaded
+/// with every frame.
+pub struct Background {
+    texture: wgpu::Texture,
+    size: (u32, u32),
+}
+
+impl Background {
+    /// Uploads `map` (Rgba32Float, read with the bilinear lookup of `EnvMap::lookup`).
+    ///
+    /// # Errors
+    /// [`GpuError::TooLarge`] for a map beyond the adapter's texture limits.
+    pub fn upload(gpu: &Gpu, map: &EnvMap) -> Result<Self, GpuError> {
+        Self::from_texels(
+            gpu,
+            (map.width(), map.height()),
+            &map.pixels().iter().map(|p| p.extend(1.0).to_array()).collect::<Vec<_>>(),
+        )
+    }
+
+    fn from_texels(gpu: &Gpu, (w, h): (u32, u32), texels: &[[f32; 4]]) -> Result<Self, GpuError> {
+        gpu.check_texture(w, h, 1)?;
+        let texture = gpu.device.create_texture_with_data(
+            &gpu.queue,
+            &wgpu::TextureDescriptor {
+                label: Some("background"),
+                size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba32Float,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            },
+            wgpu::util::TextureDataOrder::LayerMajor,
+            bytemuck::cast_slice(texels),
+        );
+        Ok(Self { texture, size: (w, h) })
+    }
 }

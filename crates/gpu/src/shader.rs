@@ -27,21 +27,33 @@ pub fn requires(source: &str) -> Vec<&str> {
 /// test catches it.
 #[must_use]
 pub fn compose(source: &str, extra: &[(&str, &str)]) -> String {
-    let mut out = String::new();
-    for name in requires(source) {
-        let Some((_, text)) = LIBRARY.iter().chain(extra).find(|(n, _)| *n == name) else {
-            panic!("shader library file {name} is not registered");
-        };
-        out.push_str(text);
-        out.push('\n');
-    }
-    // `enable` directives must come first in a module.
+    let registered = |name: &str| {
+        LIBRARY
+            .iter()
+            .chain(extra)
+            .find(|(n, _)| *n == name)
+            .map(|(_, text)| (*text).to_string())
+            .ok_or(name.to_string())
+    };
+    compose_with(source, registered).unwrap_or_else(|name| panic!("shader library file {name} is not registered"))
+}
+
+/// `source` with the library files its `// requires:` lines name prepended, each fetched by
+/// `resolve` (from a table at run time, from `shaders/` in the workspace test); `enable`
+/// directives stay first.
+///
+/// # Errors
+/// The first error `resolve` returns.
+pub fn compose_with<E>(source: &str, resolve: impl Fn(&str) -> Result<String, E>) -> Result<String, E> {
     let (enables, body): (Vec<&str>, Vec<&str>) = source.lines().partition(|l| l.trim_start().starts_with("enable "));
     let mut text = enables.join("\n");
     text.push('\n');
-    text.push_str(&out);
+    for name in requires(source) {
+        text.push_str(&resolve(name)?);
+        text.push('\n');
+    }
     text.push_str(&body.join("\n"));
-    text
+    Ok(text)
 }
 
 /// Compiles `source` (composed with [`compose`]) into a module.

@@ -4,7 +4,7 @@
 
 use envmap_sphere::{EnvMap, Sh9};
 use glam::Vec3;
-use gpu::{GBuffer, Gpu, SceneGeometry, ShadeLight, ShadeParams, ShadingPass, Visibility};
+use gpu::{Background, GBufferPass, Gpu, SceneGeometry, ShadeLight, ShadeParams, ShadingPass, Visibility};
 use ref_tracer::{EnvLight, Integrator, LightSet, RenderSettings, SceneBvh, render};
 use scene::{Camera, DistantLight, Ggx, Material, Mesh, Object, PointLight, Scene};
 
@@ -18,9 +18,9 @@ fn camera(eye: Vec3, target: Vec3, w: u32, h: u32) -> Camera {
 
 fn gpu_render(gpu: &Gpu, scene: &Scene, params: &ShadeParams) -> (Vec<Vec3>, Vec<[f32; 4]>) {
     let geometry = SceneGeometry::upload(gpu, scene).unwrap();
-    let gb = GBuffer::render(gpu, &geometry, &scene.camera).unwrap();
+    let gb = GBufferPass::new(gpu).render(gpu, &geometry, &scene.camera).unwrap();
     let vis = Visibility::new(gpu, scene.camera.width, scene.camera.height, params.lights.len() as u32).unwrap();
-    let image = ShadingPass::new(gpu).render(gpu, &geometry, &gb, params, &vis).unwrap();
+    let image = ShadingPass::new(gpu).unwrap().render(gpu, &geometry, &gb, params, &vis).unwrap();
     (image, gb.read_positions(gpu).unwrap())
 }
 
@@ -83,10 +83,11 @@ fn shading_matches_ref_tracer_lights_without_shadows() {
     let sky = EnvMap::from_fn(64, 32, |d| Vec3::new(0.3, 0.4, 0.6) * (0.5 + 0.5 * d.y) + Vec3::splat(0.05));
     let ambient = Sh9::project(&sky);
     let shade_lights: Vec<ShadeLight> = lights.iter().map(ShadeLight::from).collect();
+    let background = Background::upload(&gpu, &sky).unwrap();
     let (image, positions) = gpu_render(
         &gpu,
         &scene,
-        &ShadeParams { lights: &shade_lights, ambient: Some(&ambient), background: Some(&sky) },
+        &ShadeParams { lights: &shade_lights, ambient: Some(&ambient), background: Some(&background) },
     );
     let bvh = SceneBvh::new(&scene);
     let set = LightSet {

@@ -52,7 +52,8 @@ impl<E: LightExtractor> LightExtractor for AboveHorizon<E> {
             self.up.try_normalize().ok_or_else(|| ExtractError::Parameter("up must be a non-zero vector".into()))?;
         let upper = upper_hemisphere(map, up);
         let mut d = self.inner.extract(&upper)?;
-        let (full, kept) = (map.power(), upper.power());
+        // the inner method's books already hold the upper hemisphere's power
+        let (full, kept) = (map.power(), d.map_power);
         d.params = serde_json::json!({
             "inner": d.params,
             "up": up.to_array(),

@@ -270,15 +270,20 @@ impl ShadowMapper {
             settings.rejection = Rejection::Discard;
         }
         let res = settings.resolution;
-        let (center, radius) = bounds(geometry);
+        // a point light's maps reach the farthest geometry
+        let far_from = |p: Vec3| (reach(geometry, p) * 1.01).max(settings.near * 2.0);
         let mut frame = None;
         // (view, culling test) per layer
         let mut views: Vec<(ShadowView, Classifier)> = Vec::new();
         let cull = settings.cull;
         match (technique, *light) {
             (Technique::DualParaboloid, ShadowLight::Point { position, hemisphere }) => {
-                let far = (reach(geometry, position) * 1.01).max(settings.near * 2.0);
-                let f = ParaboloidFrame::new(position, hemisphere.unwrap_or(Vec3::NEG_Y), settings.near, far);
+                let f = ParaboloidFrame::new(
+                    position,
+                    hemisphere.unwrap_or(Vec3::NEG_Y),
+                    settings.near,
+                    far_from(position),
+                );
                 frame = Some(f);
                 let maps: &[Hemisphere] =
                     if hemisphere.is_some() { &[Hemisphere::Front] } else { &[Hemisphere::Front, Hemisphere::Back] };
@@ -302,7 +307,7 @@ impl ShadowMapper {
                 }
             }
             (Technique::Cube, ShadowLight::Point { position, .. }) => {
-                let far = (reach(geometry, position) * 1.01).max(settings.near * 2.0);
+                let far = far_from(position);
                 let proj =
                     glam::camera::rh::proj::directx::perspective(std::f32::consts::FRAC_PI_2, 1.0, settings.near, far);
                 for (a, up) in CUBE_FACES {
@@ -325,6 +330,7 @@ impl ShadowMapper {
                 }
             }
             (Technique::Orthographic, ShadowLight::Distant { direction }) => {
+                let (center, radius) = bounds(geometry);
                 let d = direction.normalize_or(Vec3::Y);
                 let up = if d.y.abs() < 0.9 { Vec3::Y } else { Vec3::X };
                 // the map's footprint: the focus (or the whole scene); its depth range: the
@@ -348,35 +354,15 @@ impl ShadowMapper {
             }
             (t, l) => return Err(GpuError::Failed(format!("a {t:?} shadow map does not fit a {l:?}"))),
         }
-        gpu.check_texture(res, res, views.len() as u32)?;
-        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("shadow map"),
-            size: wgpu::Extent3d { width: res, height: res, depth_or_array_layers: views.len() as u32 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: DEPTH_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+        let texture = gpu::render_target(gpu, "shadow map", (res, res, views.len() as u32), DEPTH_FORMAT)?;
         // (pipeline for chunks inside the view, pipeline for chunks across its edge)
         let (inside, straddle) = match (technique, settings.rejection, &self.paraboloid_clip) {
             (Technique::DualParaboloid, Rejection::ClipDistance, Some(p)) => (&self.paraboloid_plain, p),
             (Technique::DualParaboloid, _, _) => (&self.paraboloid_plain, &self.paraboloid_discard),
             _ => (&self.matrix, &self.matrix),
         };
-        let layer_views: Vec<wgpu::TextureView> = (0..views.len() as u32)
-            .map(|layer| {
-                texture.create_view(&wgpu::TextureViewDescriptor {
-                    dimension: Some(wgpu::TextureViewDimension::D2),
-                    base_array_layer: layer,
-                    array_layer_count: Some(1),
-                    ..Default::default()
-                })
-            })
-            .collect();
+        let layer_views: Vec<wgpu::TextureView> =
+            (0..views.len() as u32).map(|l| gpu::layer_view(&texture, l)).collect();
         let binds: Vec<wgpu::BindGroup> = views
             .iter()
             .map(|(v, _)| {

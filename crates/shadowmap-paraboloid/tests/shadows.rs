@@ -3,7 +3,7 @@
 //! direction, the hemisphere boundary, tiny and huge scales, a light inside an occluder.
 
 use glam::Vec3;
-use gpu::{GBuffer, Gpu, SceneGeometry, ShadowGeometry, Visibility, scene_triangles};
+use gpu::{GBuffer, GBufferPass, Gpu, SceneGeometry, ShadowGeometry, Visibility, scene_triangles};
 use ref_tracer::SceneBvh;
 use ref_tracer::visibility::{VisibilityLight, light_visibility};
 use scene::{Material, Mesh, Object, Scene};
@@ -40,7 +40,7 @@ impl Setup {
     fn new(scene: Scene) -> Self {
         let gpu = gpu();
         let geometry = SceneGeometry::upload(&gpu, &scene).unwrap();
-        let gb = GBuffer::render(&gpu, &geometry, &scene.camera).unwrap();
+        let gb = GBufferPass::new(&gpu).render(&gpu, &geometry, &scene.camera).unwrap();
         let mapper = ShadowMapper::new(&gpu);
         Self { gpu, scene, gb, mapper }
     }
