@@ -215,21 +215,32 @@ impl EnvDistribution {
     pub fn sample_dir(&self, u: Vec2) -> DirSample {
         let (j, t) = self.rows.sample(u.y);
         let (i, s) = self.cols[j].sample(u.x);
-        let phi = TAU * (i as f32 + s) / self.width as f32;
-        let (c0, c1) = self.row_cos[j];
-        let cos_theta = (c0 + f64::from(t) * (c1 - c0)).clamp(-1.0, 1.0) as f32;
-        let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-        let (sp, cp) = phi.sin_cos();
-        let dir = Vec3::new(sin_theta * sp, cos_theta, -sin_theta * cp);
-        // uv of the same point, kept inside the sampled texel despite rounding
-        let (w, h) = (self.width as f32, self.height as f32);
-        let inside =
-            |x: f32, k: usize, n: f32| x.clamp(k as f32 / n, ((k + 1) as f32 / n).next_down()).min(ONE_MINUS_EPSILON);
-        let theta = sin_theta.atan2(cos_theta);
-        let uv = Vec2::new(inside((i as f32 + s) / w, i, w), inside(theta / std::f32::consts::PI, j, h));
-        // The pdf of the texel the sample was drawn in. `dir_pdf(dir)` agrees except within
-        // f32 rounding of a texel edge, where the direction may round into the neighbour.
-        DirSample { dir, pdf: self.texel_pdf[j * self.width as usize + i], uv }
+        let w = self.width as usize;
+        texel_point([w, self.height as usize], &self.row_cos, [i, j], [s, t], self.texel_pdf[j * w + i])
+    }
+
+    /// Size of the map (width, height).
+    #[must_use]
+    pub fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    /// Probability of drawing row `j`.
+    #[must_use]
+    pub fn row_probability(&self, j: usize) -> f64 {
+        self.rows.cell_probability(j)
+    }
+
+    /// Probability of drawing column `i` once row `j` is drawn.
+    #[must_use]
+    pub fn column_probability(&self, j: usize, i: usize) -> f64 {
+        self.cols[j].cell_probability(i)
+    }
+
+    /// The pdf per steradian of texel (i, j).
+    #[must_use]
+    pub fn texel_pdf(&self, i: usize, j: usize) -> f32 {
+        self.texel_pdf[j * self.width as usize + i]
     }
 
     /// Density with respect to solid angle of sampling `dir` (need not be normalized).
@@ -265,4 +276,31 @@ impl EnvDistribution {
         let t = ((c0 - f64::from(d.y)) / (c0 - c1)).clamp(0.0, 1.0) as f32;
         (i, j, (x - i as f32).clamp(0.0, ONE_MINUS_EPSILON), t.min(ONE_MINUS_EPSILON))
     }
+}
+
+/// The point (s, t) in [0, 1)^2 of texel (i, j), uniform in phi and cos theta (`row_cos` holds
+/// each row's cos theta bounds), as a [`DirSample`] with the given pdf. Shared by both samplers.
+#[inline]
+pub(crate) fn texel_point(
+    [width, height]: [usize; 2],
+    row_cos: &[(f64, f64)],
+    [i, j]: [usize; 2],
+    [s, t]: [f32; 2],
+    pdf: f32,
+) -> DirSample {
+    let (w, h) = (width as f32, height as f32);
+    let phi = TAU * (i as f32 + s) / w;
+    let (c0, c1) = row_cos[j];
+    let cos_theta = (c0 + f64::from(t) * (c1 - c0)).clamp(-1.0, 1.0) as f32;
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    let (sp, cp) = phi.sin_cos();
+    let dir = Vec3::new(sin_theta * sp, cos_theta, -sin_theta * cp);
+    // uv of the same point, kept inside the sampled texel despite rounding
+    let inside =
+        |x: f32, k: usize, n: f32| x.clamp(k as f32 / n, ((k + 1) as f32 / n).next_down()).min(ONE_MINUS_EPSILON);
+    let theta = sin_theta.atan2(cos_theta);
+    let uv = Vec2::new(inside((i as f32 + s) / w, i, w), inside(theta / std::f32::consts::PI, j, h));
+    // The pdf of the texel the sample was drawn in. `dir_pdf(dir)` agrees except within
+    // f32 rounding of a texel edge, where the direction may round into the neighbour.
+    DirSample { dir, pdf, uv }
 }

@@ -155,17 +155,19 @@ impl EnvMap {
     /// Bilinear lookup at lat-long coordinates: wraps in u, clamps in v.
     #[must_use]
     pub fn lookup_uv(&self, uv: Vec2) -> Vec3 {
-        let (w, h) = (self.width as i64, self.height as i64);
+        let (w, h) = (self.width as usize, self.height as usize);
         let x = uv.x * self.width as f32 - 0.5;
         let y = (uv.y * self.height as f32 - 0.5).clamp(0.0, (h - 1) as f32);
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
-        let xi0 = (x0 as i64).rem_euclid(w) as u32;
-        let xi1 = (x0 as i64 + 1).rem_euclid(w) as u32;
-        let yi0 = y0 as u32;
-        let yi1 = (y0 as i64 + 1).min(h - 1) as u32;
-        let top = self.pixel(xi0, yi0).lerp(self.pixel(xi1, yi0), fx);
-        let bottom = self.pixel(xi0, yi1).lerp(self.pixel(xi1, yi1), fx);
+        // u in [0, 1] needs no division to wrap; anything else takes rem_euclid
+        let wrap = |k: i64| if (0..w as i64).contains(&k) { k as usize } else { k.rem_euclid(w as i64) as usize };
+        let (xi0, xi1) = (wrap(x0 as i64), wrap(x0 as i64 + 1));
+        let yi0 = y0 as usize;
+        let yi1 = (yi0 + 1).min(h - 1);
+        let (r0, r1) = (&self.pixels[yi0 * w..(yi0 + 1) * w], &self.pixels[yi1 * w..(yi1 + 1) * w]);
+        let top = r0[xi0].lerp(r0[xi1], fx);
+        let bottom = r1[xi0].lerp(r1[xi1], fx);
         top.lerp(bottom, fy)
     }
 

@@ -11,7 +11,7 @@
 
 use crate::bvh::{SceneBvh, SurfacePoint};
 use crate::sampler::PixelSampler;
-use envmap_sphere::{EnvDistribution, EnvMap, Sh9};
+use envmap_sphere::{EnvAliasDistribution, EnvDistribution, EnvMap, Sh9};
 use glam::Vec3;
 use scene::DistantLight;
 use scene::brdf::Frame;
@@ -32,8 +32,8 @@ pub enum Strategy {
 pub struct EnvLight<'a> {
     /// The map.
     pub map: &'a EnvMap,
-    /// Its importance sampling distribution.
-    pub dist: EnvDistribution,
+    /// Its importance sampling distribution, in alias form: O(1) draws.
+    pub dist: EnvAliasDistribution,
 }
 
 impl<'a> EnvLight<'a> {
@@ -41,7 +41,7 @@ impl<'a> EnvLight<'a> {
     /// evaluated bilinearly).
     #[must_use]
     pub fn new(map: &'a EnvMap) -> Self {
-        Self { map, dist: EnvDistribution::for_bilinear(map) }
+        Self { map, dist: EnvAliasDistribution::new(&EnvDistribution::for_bilinear(map)) }
     }
 }
 
