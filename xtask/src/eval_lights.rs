@@ -30,6 +30,9 @@ struct Row {
     method: String,
     lights: usize,
     rmse: f64,
+    /// RMSE against the converged truth, estimated: the truth's own noise variance (half the
+    /// floor's mean square) taken out of the mean square error, clamped at zero.
+    converged_rmse: f64,
     flip: f64,
     extract_ms: f64,
 }
@@ -94,7 +97,11 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
             (scene.camera.width, scene.camera.height) = args.size;
             let bvh = SceneBvh::new(&scene);
             bar.set_message(format!("{map_name} / {scene_name}"));
-            let truth = RenderSettings { spp: args.spp, seed: 1, time_budget: None, aovs: false };
+            // Every render goes through the same lights_spp sub-pixel positions, so a method's
+            // error holds no antialiasing noise, only its lighting error and lighting noise.
+            let positions = Some(args.lights_spp.max(1));
+            let truth =
+                RenderSettings { spp: args.spp, seed: 1, time_budget: None, aovs: false, pixel_positions: positions };
             let reference =
                 ref_tracer::render(&scene, &bvh, Some(&env), &Integrator::EnvDirect(Strategy::Mis), &truth, &|_, _| {});
             bar.inc(1);
@@ -104,12 +111,17 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
             let floor =
                 ref_tracer::render(&scene, &bvh, Some(&env), &Integrator::EnvDirect(Strategy::Mis), &again, &|_, _| {});
             bar.inc(1);
+            // Two truths differ by twice the truth's noise variance.
+            let floor_rmse = rmse(&reference.color, &floor.color);
+            let truth_variance = floor_rmse * floor_rmse / 2.0;
+            let converged = |e: f64| (e * e - truth_variance).max(0.0).sqrt();
             rows.push(Row {
                 map: map_name.clone(),
                 scene: scene_name.clone(),
                 method: "(reference, other seed)".into(),
                 lights: 0,
-                rmse: rmse(&reference.color, &floor.color),
+                rmse: floor_rmse,
+                converged_rmse: converged(floor_rmse),
                 flip: flip(&reference.color, &floor.color, floor.width, floor.height, &tm),
                 extract_ms: 0.0,
             });
@@ -123,7 +135,13 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
                     shadow_ambient: false,
                     background: Some(&map),
                 };
-                let settings = RenderSettings { spp: args.lights_spp.max(1), seed: 2, time_budget: None, aovs: false };
+                let settings = RenderSettings {
+                    spp: args.lights_spp.max(1),
+                    seed: 2,
+                    time_budget: None,
+                    aovs: false,
+                    pixel_positions: positions,
+                };
                 let img = ref_tracer::render(&scene, &bvh, None, &Integrator::Lights(set), &settings, &|_, _| {});
                 bar.inc(1);
                 rows.push(Row {
@@ -132,6 +150,7 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
                     method: d.method.clone(),
                     lights: d.lights.len(),
                     rmse: rmse(&reference.color, &img.color),
+                    converged_rmse: converged(rmse(&reference.color, &img.color)),
                     flip: flip(&reference.color, &img.color, img.width, img.height, &tm),
                     extract_ms: d.time_ms,
                 });
@@ -173,23 +192,26 @@ fn summary(rows: &[Row], value: impl Fn(&Row) -> f64) -> Vec<(String, f64, f64)>
 
 fn write_tables(rows: &[Row], args: &EvalArgs) -> Result<(), String> {
     std::fs::create_dir_all(&args.out).map_err(|e| format!("{}: {e}", args.out.display()))?;
-    let mut csv = String::from("map,scene,method,lights,rmse,flip,extract_ms\n");
+    let mut csv = String::from("map,scene,method,lights,rmse,converged_rmse,flip,extract_ms\n");
     for r in rows {
         let _ = writeln!(
             csv,
-            "{},{},{},{},{:.6},{:.6},{:.3}",
-            r.map, r.scene, r.method, r.lights, r.rmse, r.flip, r.extract_ms
+            "{},{},{},{},{:.6},{:.6},{:.6},{:.3}",
+            r.map, r.scene, r.method, r.lights, r.rmse, r.converged_rmse, r.flip, r.extract_ms
         );
     }
-    let (rm, fl) = (summary(rows, |r| r.rmse), summary(rows, |r| r.flip));
+    let (rm, cv, fl) = (summary(rows, |r| r.rmse), summary(rows, |r| r.converged_rmse), summary(rows, |r| r.flip));
     let base = |s: &[(String, f64, f64)]| s.iter().find(|(m, _, _)| m == "median-cut").map_or(f64::NAN, |x| x.1);
-    let (brm, bfl) = (base(&rm), base(&fl));
+    let (brm, bcv, bfl) = (base(&rm), base(&cv), base(&fl));
     let mut md = String::new();
     let _ = writeln!(
         md,
         "# Light extraction against the env-direct truth\n\n{} maps x scenes {}, K = {}, {} x {}, reference {} spp, \
-         lights renders {} spp with 8 interleaved sets. \"(reference, other seed)\" is the noise floor: \
-         the truth rendered again with another seed.\n",
+         lights renders {} spp with 8 interleaved sets (stratified over each pixel's samples); every render \
+         goes through the same sub-pixel positions, so no antialiasing noise enters the errors. \
+         \"(reference, other seed)\" is the noise floor: the truth rendered again with another seed. \
+         \"converged RMSE\" estimates the RMSE against the converged truth: the truth's noise variance \
+         (half the floor's mean square) is taken out of each mean square error.\n",
         rows.iter().map(|r| &r.map).collect::<std::collections::BTreeSet<_>>().len(),
         args.scenes.join(", "),
         args.lights,
@@ -200,11 +222,18 @@ fn write_tables(rows: &[Row], args: &EvalArgs) -> Result<(), String> {
     );
     let _ = writeln!(
         md,
-        "| method | mean RMSE | RMSE / median cut | mean rank (RMSE) | mean FLIP | FLIP / median cut | mean rank (FLIP) |"
+        "| method | mean RMSE | RMSE / median cut | mean rank (RMSE) | converged RMSE | / median cut | mean FLIP | \
+         FLIP / median cut | mean rank (FLIP) |"
     );
-    let _ = writeln!(md, "|---|---|---|---|---|---|---|");
-    for ((m, r, rr), (_, f, fr)) in rm.iter().zip(&fl) {
-        let _ = writeln!(md, "| {m} | {r:.4} | {:.2} | {rr:.2} | {f:.4} | {:.2} | {fr:.2} |", r / brm, f / bfl);
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|");
+    for (((m, r, rr), (_, c, _)), (_, f, fr)) in rm.iter().zip(&cv).zip(&fl) {
+        let _ = writeln!(
+            md,
+            "| {m} | {r:.4} | {:.2} | {rr:.2} | {c:.4} | {:.2} | {f:.4} | {:.2} | {fr:.2} |",
+            r / brm,
+            c / bcv,
+            f / bfl
+        );
     }
     let csv_path = args.out.join("eval-lights.csv");
     let md_path = args.out.join("eval-lights.md");

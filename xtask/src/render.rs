@@ -50,6 +50,10 @@ pub struct RenderArgs {
     /// Also write the AOVs.
     #[arg(long)]
     pub aovs: bool,
+    /// Trace through N fixed sub-pixel positions (sample k through position k mod N, the same
+    /// for every seed), so that renders compared with `compare` differ only in their lighting.
+    #[arg(long)]
+    pub pixel_positions: Option<u32>,
 }
 
 /// The map from `--envmap`, or the embedded default.
@@ -167,6 +171,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         seed: args.seed,
         time_budget: args.time_budget.map(Duration::from_secs_f64),
         aovs: args.aovs,
+        pixel_positions: args.pixel_positions,
     };
     let img = ref_tracer::render(&scene, &bvh, Some(&env), &integrator, &settings, &|done, _| {
         bar.set_position(u64::from(done))

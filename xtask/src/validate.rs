@@ -156,7 +156,8 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
     let bvh = SceneBvh::new(&scene);
     let env = EnvLight::new(&map);
     let t = Instant::now();
-    let settings = RenderSettings { spp: plan.reference_spp, seed: 1, time_budget: None, aovs: false };
+    let settings =
+        RenderSettings { spp: plan.reference_spp, seed: 1, time_budget: None, aovs: false, pixel_positions: None };
     let reference =
         ref_tracer::render(&scene, &bvh, Some(&env), &Integrator::EnvDirect(Strategy::Mis), &settings, &|_, _| {});
     let reference_s = t.elapsed().as_secs_f64();
@@ -170,7 +171,8 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
         shadow_ambient: false,
         background: Some(&map),
     };
-    let settings = RenderSettings { spp: plan.lights_spp, seed: 2, time_budget: None, aovs: false };
+    let settings =
+        RenderSettings { spp: plan.lights_spp, seed: 2, time_budget: None, aovs: false, pixel_positions: None };
     let traced = ref_tracer::render(&scene, &bvh, None, &Integrator::Lights(set), &settings, &|_, _| {});
     let traced_s = t.elapsed().as_secs_f64();
 

@@ -262,7 +262,7 @@ fn eval_lights_writes_both_tables_with_a_noise_floor() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let csv = std::fs::read_to_string(out_dir.join("eval-lights.csv")).expect("csv");
     let lines: Vec<&str> = csv.lines().collect();
-    assert_eq!(lines[0], "map,scene,method,lights,rmse,flip,extract_ms");
+    assert_eq!(lines[0], "map,scene,method,lights,rmse,converged_rmse,flip,extract_ms");
     assert_eq!(lines.len(), 1 + 11, "floor + five methods + three ablations + two above-horizon: {csv}");
     for ablation in ["emissive-split/no-masking", "emissive-split/no-kmeans", "emissive-split/neither"] {
         assert!(csv.contains(&format!(",{ablation},")), "{ablation} missing:\n{csv}");

@@ -49,9 +49,10 @@ impl<'a> EnvLight<'a> {
 pub struct LightSet<'a> {
     /// Distant cone lights.
     pub lights: &'a [DistantLight],
-    /// Extra light sets of interleaved sampling (paper 001, section 3.5): each sample uses
-    /// `lights` or one of these, uniformly — the converged result of interleaving followed by a
-    /// perfect filter. Empty: `lights` only.
+    /// Extra light sets of interleaved sampling (paper 001, section 3.5): pixel sample k uses
+    /// set k mod (sets + 1), `lights` being set 0 — stratified, so with a sample count that is a
+    /// multiple of the set count each set lights a pixel equally often: the converged result of
+    /// interleaving followed by a perfect filter. Empty: `lights` only.
     pub interleaved: &'a [Vec<DistantLight>],
     /// Ambient radiance as SH9 (its irradiance lights the diffuse lobe), if any.
     pub ambient: Option<Sh9>,
@@ -202,8 +203,8 @@ fn lights_direct(bvh: &SceneBvh, set: &LightSet, sh: &Shading, s: &mut PixelSamp
     let lights = if set.interleaved.is_empty() {
         set.lights
     } else {
-        let k = (s.next_1d() * (set.interleaved.len() + 1) as f32) as usize;
-        if k == 0 { set.lights } else { &set.interleaved[(k - 1).min(set.interleaved.len() - 1)] }
+        let k = (s.sample_index() % (set.interleaved.len() as u64 + 1)) as usize;
+        if k == 0 { set.lights } else { &set.interleaved[k - 1] }
     };
     for light in lights {
         let (dir, pdf) = light.sample_direction(s.next_2d());

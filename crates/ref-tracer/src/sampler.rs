@@ -15,6 +15,7 @@ fn mix(mut z: u64) -> u64 {
 /// The random stream of one pixel sample.
 pub struct PixelSampler {
     rng: Pcg32,
+    sample: u64,
 }
 
 impl PixelSampler {
@@ -25,7 +26,14 @@ impl PixelSampler {
             ^ mix(pixel.wrapping_add(0x9e37_79b9_7f4a_7c15))
             ^ mix(sample.wrapping_mul(0x2545_f491_4f6c_dd1d)));
         // state and stream straight from the key: cheaper than seed_from_u64's seeding PCG
-        Self { rng: Pcg32::new(key, mix(key ^ 0xda3e_39cb_94b9_5bdb)) }
+        Self { rng: Pcg32::new(key, mix(key ^ 0xda3e_39cb_94b9_5bdb)), sample }
+    }
+
+    /// The index of the pixel sample this stream belongs to (for stratifying a discrete choice
+    /// over a pixel's samples).
+    #[must_use]
+    pub fn sample_index(&self) -> u64 {
+        self.sample
     }
 
     /// A number in [0, 1).

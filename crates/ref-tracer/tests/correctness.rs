@@ -14,16 +14,18 @@ fn small(name: &str, w: u32, h: u32) -> Scene {
 }
 
 fn run(scene: &Scene, map: Option<&EnvMap>, integrator: &Integrator, spp: u32, seed: u64) -> Render {
+    run_with(
+        scene,
+        map,
+        integrator,
+        &RenderSettings { spp, seed, time_budget: None, aovs: true, pixel_positions: None },
+    )
+}
+
+fn run_with(scene: &Scene, map: Option<&EnvMap>, integrator: &Integrator, settings: &RenderSettings) -> Render {
     let bvh = SceneBvh::new(scene);
     let env = map.map(EnvLight::new);
-    render(
-        scene,
-        &bvh,
-        env.as_ref(),
-        integrator,
-        &RenderSettings { spp, seed, time_budget: None, aovs: true },
-        &|_, _| {},
-    )
+    render(scene, &bvh, env.as_ref(), integrator, settings, &|_, _| {})
 }
 
 /// Mean over the interior pixels of object `object` (see [`interior`]).
@@ -205,6 +207,48 @@ fn a_tiny_cone_shades_like_a_directional_light() {
     let want = 0.6 / std::f32::consts::PI * theta.cos();
     for c in &r.color {
         assert!((*c / want - 1.0).abs().max_element() < 1e-3, "{c} vs {want}");
+    }
+}
+
+#[test]
+fn shared_pixel_positions_leave_no_antialiasing_noise() {
+    // Unshadowed SH9 ambient is deterministic shading: the only randomness left is where the
+    // camera rays cross each pixel, which the spheres' silhouettes make visible.
+    let sh = Sh9::project(&envmap_sphere::default_map());
+    let set = || LightSet { lights: &[], interleaved: &[], ambient: Some(sh), shadow_ambient: false, background: None };
+    let scene = small("spheres_box", 40, 30);
+    let settings =
+        |seed, pixel_positions| RenderSettings { spp: 4, seed, time_budget: None, aovs: false, pixel_positions };
+    let a = run_with(&scene, None, &Integrator::Lights(set()), &settings(1, Some(4)));
+    let b = run_with(&scene, None, &Integrator::Lights(set()), &settings(2, Some(4)));
+    assert_eq!(a.color, b.color, "the same positions for any seed");
+    let c = run_with(&scene, None, &Integrator::Lights(set()), &settings(1, None));
+    let d = run_with(&scene, None, &Integrator::Lights(set()), &settings(2, None));
+    let differ = c.color.iter().zip(&d.color).filter(|(x, y)| x != y).count();
+    assert!(differ > 20, "fresh positions differ at silhouettes: {differ} pixels");
+}
+
+#[test]
+fn interleaved_sets_are_stratified_over_a_pixels_samples() {
+    // Two sets of one tiny-cone light each, on an unoccluded plane: with 2 spp every pixel is
+    // lit by each set exactly once, so every pixel is the mean of the two sets' shading.
+    let mut scene = small("three_boxes", 16, 12);
+    scene.objects.truncate(1); // the ground alone
+    let omega = 1e-6;
+    let light = |theta: f32, l: f32| DistantLight {
+        direction: Vec3::new(theta.to_radians().sin(), theta.to_radians().cos(), 0.0),
+        solid_angle: omega,
+        radiance: Vec3::splat(l / omega),
+    };
+    let (a, b) = ([light(10.0, 1.0)], vec![vec![light(60.0, 3.0)]]);
+    let set = LightSet { lights: &a, interleaved: &b, ambient: None, shadow_ambient: false, background: None };
+    let r = run(&scene, None, &Integrator::Lights(set), 2, 3);
+    let albedo = scene.objects[0].material.albedo.x;
+    let want = albedo / std::f32::consts::PI * (10f32.to_radians().cos() + 3.0 * 60f32.to_radians().cos()) / 2.0;
+    for (k, c) in r.color.iter().enumerate() {
+        if interior(&r, k, 0) {
+            assert!((c.x / want - 1.0).abs() < 1e-3, "pixel {k}: {c} vs {want}");
+        }
     }
 }
 
