@@ -5,10 +5,7 @@
 //! `DIR/eval-lights.md`.
 
 use crate::render::load_map;
-use light_extract::{
-    AboveHorizon, CenterSurround, EmissiveSplit, ImportanceSampled, LightExtractor, MedianCut, VarianceMinimization,
-    interleaved_sets,
-};
+use light_extract::{EmissiveSplit, LightExtractor};
 use ref_tracer::metrics::{FlipTonemap, flip, rmse};
 use ref_tracer::{EnvLight, Integrator, LightSet, RenderSettings, SceneBvh, Strategy};
 use std::fmt::Write as _;
@@ -37,22 +34,23 @@ struct Row {
     extract_ms: f64,
 }
 
-/// (label, extractor): Table 1's methods, then Table 2's ablation of EmissiveSplit.
+/// (label, extractor): Table 1's methods, then Table 2's ablation of EmissiveSplit, then our
+/// above-horizon options (not the papers': only the hemisphere above the ground reaches the
+/// receivers).
 fn methods(k: usize) -> Vec<(String, Box<dyn LightExtractor>)> {
     let es = EmissiveSplit { lights: k, ..EmissiveSplit::default() };
-    vec![
-        ("emissive-split".into(), Box::new(es)),
-        ("center-surround".into(), Box::new(CenterSurround { max_lights: k, ..CenterSurround::default() })),
-        ("median-cut".into(), Box::new(MedianCut::with_lights(k))),
-        ("variance-min".into(), Box::new(VarianceMinimization::with_lights(k))),
-        ("importance".into(), Box::new(ImportanceSampled { count: k, seed: 0 })),
-        ("emissive-split/no-masking".into(), Box::new(EmissiveSplit { masking: false, ..es })),
-        ("emissive-split/no-kmeans".into(), Box::new(EmissiveSplit { kmeans: false, ..es })),
-        ("emissive-split/neither".into(), Box::new(EmissiveSplit { masking: false, kmeans: false, ..es })),
-        // ours, not the papers': only the hemisphere above the ground reaches the receivers
-        ("emissive-split+above-horizon".into(), Box::new(AboveHorizon::new(es))),
-        ("median-cut+above-horizon".into(), Box::new(AboveHorizon::new(MedianCut::with_lights(k)))),
-    ]
+    let ablations: [(&str, Box<dyn LightExtractor>); 3] = [
+        ("emissive-split/no-masking", Box::new(EmissiveSplit { masking: false, ..es })),
+        ("emissive-split/no-kmeans", Box::new(EmissiveSplit { kmeans: false, ..es })),
+        ("emissive-split/neither", Box::new(EmissiveSplit { masking: false, kmeans: false, ..es })),
+    ];
+    let named = |name: &str| light_extract::extractor(name, k).map(|e| (name.to_string(), e));
+    light_extract::METHODS
+        .iter()
+        .filter_map(|m| named(m))
+        .chain(ablations.into_iter().map(|(n, e)| (n.to_string(), e)))
+        .chain(["emissive-split+above-horizon", "median-cut+above-horizon"].into_iter().filter_map(named))
+        .collect()
 }
 
 pub fn run(args: &EvalArgs) -> Result<(), String> {
@@ -85,10 +83,7 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
                 let mut d = m.extract(&map).map_err(|e| format!("{}: {e}", map_path.display()))?;
                 d.method.clone_from(label);
                 // paper 001, section 3.5: 8 sets; the extra 7 as renderers take them
-                let sets: Vec<Vec<scene::DistantLight>> = interleaved_sets(&d.lights, 8, 0.1, 0)[1..]
-                    .iter()
-                    .map(|set| set.iter().map(|l| l.light).collect())
-                    .collect();
+                let sets = d.interleaved_distant_lights();
                 Ok::<_, String>((d, sets))
             })
             .collect::<Result<_, _>>()?;
@@ -144,13 +139,14 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
                 };
                 let img = ref_tracer::render(&scene, &bvh, None, &Integrator::Lights(set), &settings, &|_, _| {});
                 bar.inc(1);
+                let error = rmse(&reference.color, &img.color);
                 rows.push(Row {
                     map: map_name.clone(),
                     scene: scene_name.clone(),
                     method: d.method.clone(),
                     lights: d.lights.len(),
-                    rmse: rmse(&reference.color, &img.color),
-                    converged_rmse: converged(rmse(&reference.color, &img.color)),
+                    rmse: error,
+                    converged_rmse: converged(error),
                     flip: flip(&reference.color, &img.color, img.width, img.height, &tm),
                     extract_ms: d.time_ms,
                 });

@@ -1,40 +1,20 @@
 //! `cargo xtask extract PATH [--method M] [--lights K] [--out DIR]`: decompose a map into
 //! lights + ambient and write lights.json, ambient.exr, lights.gltf and overlay.png.
 
-use light_extract::{
-    AboveHorizon, CenterSurround, EmissiveSplit, ImportanceSampled, LightExtractor, MedianCut, VarianceMinimization,
-    interleaved_sets,
-};
+use light_extract::METHODS;
 use std::path::Path;
-
-/// Methods available now (the paper methods join as they land).
-pub const METHODS: [&str; 5] = ["emissive-split", "center-surround", "median-cut", "variance-min", "importance"];
 
 pub fn run(path: &Path, method: &str, k: usize, out: Option<&Path>, lux_per_unit: f32) -> Result<(), String> {
     let map = envmap_sphere::EnvMap::load(path).map_err(|e| e.to_string())?;
     // any method + "+above-horizon": only the hemisphere above the ground (see AboveHorizon)
-    let (base, above_horizon) = method.strip_suffix("+above-horizon").map_or((method, false), |b| (b, true));
-    let extractor: Box<dyn LightExtractor> = match base {
-        "emissive-split" => Box::new(EmissiveSplit { lights: k, ..EmissiveSplit::default() }),
-        "center-surround" => Box::new(CenterSurround { max_lights: k, ..CenterSurround::default() }),
-        "median-cut" => Box::new(MedianCut::with_lights(k)),
-        "variance-min" => Box::new(VarianceMinimization::with_lights(k)),
-        "importance" => Box::new(ImportanceSampled { count: k, seed: 0 }),
-        other => {
-            return Err(format!(
-                "unknown method {other:?}; available: {}, each optionally with +above-horizon",
-                METHODS.join(", ")
-            ));
-        }
-    };
-    let extractor: Box<dyn LightExtractor> =
-        if above_horizon { Box::new(AboveHorizon::new(extractor)) } else { extractor };
+    let extractor = light_extract::extractor(method, k).ok_or_else(|| {
+        format!("unknown method {method:?}; available: {}, each optionally with +above-horizon", METHODS.join(", "))
+    })?;
     let d = extractor.extract(&map).map_err(|e| format!("{}: {e}", path.display()))?;
     let stem = path.file_stem().map_or_else(|| "map".into(), |s| s.to_string_lossy().to_string());
     let dir = out.map_or_else(|| Path::new("target/extract").join(format!("{stem}-{method}")), Path::to_path_buf);
     // paper 001, section 3.5: 8 sets, directions perturbed within 0.1 x the cluster extent
-    let sets = interleaved_sets(&d.lights, 8, 0.1, 0);
-    d.write(&dir, &sets[1..], lux_per_unit)?;
+    d.write(&dir, &d.interleaved(), lux_per_unit)?;
     light_extract::overlay::write_overlay(&dir.join("overlay.png"), &map, &d.lights)?;
     for (k, l) in d.lights.iter().enumerate() {
         let (dir_, p) = (l.light.direction, l.power());

@@ -11,7 +11,7 @@ use glam::Vec3;
 use gpu::{
     Background, GBufferPass, Gpu, SceneGeometry, ShadeLight, ShadeParams, ShadingPass, ShadowGeometry, Visibility,
 };
-use light_extract::{EmissiveSplit, LightExtractor, interleaved_sets};
+use light_extract::{EmissiveSplit, LightExtractor};
 use ref_tracer::metrics::{FlipTonemap, flip, rmse};
 use ref_tracer::visibility::{VisibilityLight, light_visibility};
 use ref_tracer::{EnvLight, Integrator, LightSet, RenderSettings, SceneBvh, Strategy};
@@ -147,10 +147,7 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
         .extract(&map)
         .map_err(|e| format!("{map_name}: {e}"))?;
     let lights = decomposition.distant_lights();
-    let sets: Vec<Vec<scene::DistantLight>> = interleaved_sets(&decomposition.lights, 8, 0.1, 0)[1..]
-        .iter()
-        .map(|set| set.iter().map(|l| l.light).collect())
-        .collect();
+    let sets = decomposition.interleaved_distant_lights();
 
     stages.next(&format!("reference: ref-tracer env-direct, {} spp", plan.reference_spp));
     let bvh = SceneBvh::new(&scene);
@@ -473,7 +470,7 @@ struct Report<'a> {
 
 /// Relative luminance error as an 8-bit heat map (black 0, red 25 %, yellow 50 %, white ≥ 75 %).
 fn error_map(reference: &[Vec3], test: &[Vec3]) -> Vec<u8> {
-    let y = |c: Vec3| 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
+    let y = envmap_sphere::luminance;
     let mean = reference.iter().map(|c| y(*c)).sum::<f32>() / reference.len().max(1) as f32;
     reference
         .iter()

@@ -174,13 +174,13 @@ impl ShadowGeometry {
         attributes: &wgpu::vertex_attr_array![0 => Float32x3],
     };
 
-    /// Draws the chunks `visible` accepts, merging neighbours into one draw call. Returns the
-    /// number of triangles drawn.
-    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, visible: impl Fn(&Chunk) -> bool) -> u32 {
+    /// Draws the chunks whose index `visible` accepts, merging neighbours into one draw call.
+    /// Returns the number of triangles drawn.
+    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, visible: impl Fn(usize) -> bool) -> u32 {
         pass.set_vertex_buffer(0, self.vertices.slice(..));
         let mut run: Option<(u32, u32)> = None;
         let mut drawn = 0;
-        for c in self.chunks.iter().filter(|c| visible(c)) {
+        for c in self.chunks.iter().enumerate().filter(|(k, _)| visible(*k)).map(|(_, c)| c) {
             drawn += c.vertex_count / 3;
             run = match run {
                 Some((start, end)) if end == c.first_vertex => Some((start, end + c.vertex_count)),

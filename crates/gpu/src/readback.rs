@@ -64,7 +64,7 @@ pub fn read_texture_f32(gpu: &Gpu, texture: &wgpu::Texture, layer: u32) -> Resul
     let bytes = read_layer_bytes(gpu, texture, layer, aspect)?;
     match format.block_copy_size(Some(aspect)) {
         Some(1) => Ok(bytes.iter().map(|&b| f32::from(b) / 255.0).collect()),
-        Some(4) => Ok(bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect()),
+        Some(4) => Ok(bytemuck::pod_collect_to_vec(&bytes)),
         _ => Err(GpuError::Failed(format!("read_texture_f32: {format:?} is not a single-channel format"))),
     }
 }
@@ -78,8 +78,5 @@ pub fn read_texture_rgba(gpu: &Gpu, texture: &wgpu::Texture, layer: u32) -> Resu
         return Err(GpuError::Failed(format!("read_texture_rgba: {:?} is not Rgba32Float", texture.format())));
     }
     let bytes = read_layer_bytes(gpu, texture, layer, wgpu::TextureAspect::All)?;
-    Ok(bytes
-        .chunks_exact(16)
-        .map(|b| std::array::from_fn(|c| f32::from_le_bytes([b[4 * c], b[4 * c + 1], b[4 * c + 2], b[4 * c + 3]])))
-        .collect())
+    Ok(bytemuck::pod_collect_to_vec(&bytes))
 }

@@ -332,7 +332,7 @@ impl LightExtractor for CenterSurround {
             };
             let (texels, power, _) = inner_cap(&remainder, theta, phi, ri);
             let cos_r = ri.cos();
-            let intensity = glam::DVec3::new(0.2126, 0.7152, 0.0722).dot(power);
+            let intensity = envmap_sphere::color::luminance_f64(power.to_array());
             if texels.is_empty() || intensity <= 0.0 || (!lights.is_empty() && intensity < self.weber * found) {
                 break; // Weber: this light would cast no visible shadow; it stays ambient
             }

