@@ -49,7 +49,16 @@ fn methods(k: usize) -> Vec<(String, Box<dyn LightExtractor>)> {
         .iter()
         .filter_map(|m| named(m))
         .chain(ablations.into_iter().map(|(n, e)| (n.to_string(), e)))
-        .chain(["emissive-split+above-horizon", "median-cut+above-horizon"].into_iter().filter_map(named))
+        .chain(
+            [
+                "emissive-split+above-horizon",
+                "emissive-split+moment-cones",
+                "emissive-split+moment-cones+above-horizon",
+                "median-cut+above-horizon",
+            ]
+            .into_iter()
+            .filter_map(named),
+        )
         .collect()
 }
 
@@ -186,6 +195,11 @@ fn summary(rows: &[Row], value: impl Fn(&Row) -> f64) -> Vec<(String, f64, f64)>
         .collect()
 }
 
+/// A CSV field, quoted (RFC 4180) when it holds a comma, quote or line break.
+fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) { format!("\"{}\"", s.replace('"', "\"\"")) } else { s.to_string() }
+}
+
 fn write_tables(rows: &[Row], args: &EvalArgs) -> Result<(), String> {
     std::fs::create_dir_all(&args.out).map_err(|e| format!("{}: {e}", args.out.display()))?;
     let mut csv = String::from("map,scene,method,lights,rmse,converged_rmse,flip,extract_ms\n");
@@ -193,7 +207,14 @@ fn write_tables(rows: &[Row], args: &EvalArgs) -> Result<(), String> {
         let _ = writeln!(
             csv,
             "{},{},{},{},{:.6},{:.6},{:.6},{:.3}",
-            r.map, r.scene, r.method, r.lights, r.rmse, r.converged_rmse, r.flip, r.extract_ms
+            csv_field(&r.map),
+            csv_field(&r.scene),
+            csv_field(&r.method),
+            r.lights,
+            r.rmse,
+            r.converged_rmse,
+            r.flip,
+            r.extract_ms
         );
     }
     let (rm, cv, fl) = (summary(rows, |r| r.rmse), summary(rows, |r| r.converged_rmse), summary(rows, |r| r.flip));
@@ -236,7 +257,7 @@ fn write_tables(rows: &[Row], args: &EvalArgs) -> Result<(), String> {
     std::fs::write(&csv_path, csv).map_err(|e| format!("{}: {e}", csv_path.display()))?;
     std::fs::write(&md_path, &md).map_err(|e| format!("{}: {e}", md_path.display()))?;
     print!("{md}");
-    println!("\nwrote {} and {}", csv_path.display(), md_path.display());
+    outln!("\nwrote {} and {}", csv_path.display(), md_path.display());
     Ok(())
 }
 

@@ -1,14 +1,18 @@
 //! `cargo xtask extract PATH [--method M] [--lights K] [--out DIR]`: decompose a map into
 //! lights + ambient and write lights.json, ambient.exr, lights.gltf and overlay.png.
 
-use light_extract::METHODS;
+use light_extract::{METHODS, OPTIONS};
 use std::path::Path;
 
 pub fn run(path: &Path, method: &str, k: usize, out: Option<&Path>, lux_per_unit: f32) -> Result<(), String> {
     let map = envmap_sphere::EnvMap::load(path).map_err(|e| e.to_string())?;
-    // any method + "+above-horizon": only the hemisphere above the ground (see AboveHorizon)
+    // a method + our options, e.g. "+above-horizon": only the hemisphere above the ground
     let extractor = light_extract::extractor(method, k).ok_or_else(|| {
-        format!("unknown method {method:?}; available: {}, each optionally with +above-horizon", METHODS.join(", "))
+        format!(
+            "unknown method {method:?}; available: {}, with options +{} (in that order; moment-cones for emissive-split only)",
+            METHODS.join(", "),
+            OPTIONS.join(", +")
+        )
     })?;
     let d = extractor.extract(&map).map_err(|e| format!("{}: {e}", path.display()))?;
     let stem = path.file_stem().map_or_else(|| "map".into(), |s| s.to_string_lossy().to_string());
@@ -18,7 +22,7 @@ pub fn run(path: &Path, method: &str, k: usize, out: Option<&Path>, lux_per_unit
     light_extract::overlay::write_overlay(&dir.join("overlay.png"), &map, &d.lights)?;
     for (k, l) in d.lights.iter().enumerate() {
         let (dir_, p) = (l.light.direction, l.power());
-        println!(
+        outln!(
             "light {k:>4}  dir [{:+.4}, {:+.4}, {:+.4}]  half-angle {:.3} deg  power [{:.4e}, {:.4e}, {:.4e}]  extent {:.2} deg",
             dir_.x,
             dir_.y,
@@ -31,7 +35,7 @@ pub fn run(path: &Path, method: &str, k: usize, out: Option<&Path>, lux_per_unit
         );
     }
     let lp = d.light_power();
-    println!(
+    outln!(
         "{}: {} lights in {:.2} ms; light power / map power = {:.4} (G); wrote {}",
         d.method,
         d.lights.len(),

@@ -36,36 +36,41 @@ impl MapInfo {
     /// Human-readable lines.
     pub fn print_text(&self, name: &str, map: &EnvMap, report: &LoadReport) {
         let stats = map.luminance_stats();
-        println!("{name}");
-        println!("  size          {} x {}", self.width, self.height);
-        println!("  format        {} ({})", self.format, self.compression);
-        println!(
+        outln!("{name}");
+        outln!("  size          {} x {}", self.width, self.height);
+        outln!("  format        {} ({})", self.format, self.compression);
+        outln!(
             "  luminance     max {:.6}, mean {:.6} per pixel, {:.6} per sr",
-            self.max_luminance, self.mean_luminance, stats.mean_per_sr
+            self.max_luminance,
+            self.mean_luminance,
+            stats.mean_per_sr
         );
-        println!(
+        outln!(
             "  percentiles   50%: {:.4}  90%: {:.4}  98%: {:.4}  99.9%: {:.4}",
             stats.percentile(50.0),
             stats.percentile(90.0),
             stats.percentile(98.0),
             stats.percentile(99.9)
         );
-        println!(
+        outln!(
             "  power         [{:.6}, {:.6}, {:.6}] (integral of radiance over the sphere)",
-            self.power[0], self.power[1], self.power[2]
+            self.power[0],
+            self.power[1],
+            self.power[2]
         );
         let labels = ["l0", "l1 m-1", "l1 m0", "l1 m1", "l2 m-2", "l2 m-1", "l2 m0", "l2 m1", "l2 m2"];
         for (label, c) in labels.iter().zip(&self.sh9) {
-            println!("  sh9 {label:<7}  [{:+.6}, {:+.6}, {:+.6}]", c[0], c[1], c[2]);
+            outln!("  sh9 {label:<7}  [{:+.6}, {:+.6}, {:+.6}]", c[0], c[1], c[2]);
         }
         if report.negatives_clamped > 0 {
-            println!(
+            outln!(
                 "  clamped       {} negative values to zero ({:.3e} of the power)",
-                report.negatives_clamped, report.negative_power_fraction
+                report.negatives_clamped,
+                report.negative_power_fraction
             );
         }
         for w in &report.warnings {
-            println!("  warning       {w}");
+            outln!("  warning       {w}");
         }
     }
 }
@@ -74,7 +79,7 @@ pub fn run(path: &Path, json: bool) -> Result<(), String> {
     let (map, report) = EnvMap::load_with(path, &LoadOptions::default()).map_err(|e| e.to_string())?;
     let info = MapInfo::new(&map, &report);
     if json {
-        println!("{}", serde_json::to_string(&info).map_err(|e| e.to_string())?);
+        outln!("{}", serde_json::to_string(&info).map_err(|e| e.to_string())?);
     } else {
         info.print_text(&path.display().to_string(), &map, &report);
     }

@@ -35,7 +35,7 @@ pub fn ensure() -> Result<(), String> {
     if !is_root() {
         return Err(format!("Mesa's lavapipe (software Vulkan) is missing: run `sudo sh -c '{INSTALL}'`"));
     }
-    println!("installing Mesa's lavapipe: {INSTALL}");
+    outln!("installing Mesa's lavapipe: {INSTALL}");
     let status = Command::new("sh")
         .args(["-c", INSTALL])
         .env("DEBIAN_FRONTEND", "noninteractive")

@@ -3,6 +3,14 @@
 
 #![allow(clippy::print_stdout, clippy::print_stderr)]
 
+/// `println!` that ignores a closed stdout (`cargo xtask compare a b | head -1` must not panic).
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
 mod eval_lights;
 mod extract;
 mod info;
@@ -54,7 +62,8 @@ enum Command {
         path: PathBuf,
         /// emissive-split, center-surround (stops by Weber's law; K is a cap), median-cut,
         /// variance-min or importance; append +above-horizon to model only the hemisphere above
-        /// the ground (for scenes standing on an opaque ground).
+        /// the ground (for scenes standing on an opaque ground), and to emissive-split
+        /// +moment-cones (before +above-horizon) for cones matching each cluster's spread.
         #[arg(long, default_value = "median-cut")]
         method: String,
         /// Number of lights K (median cut uses the largest power of two not above K).

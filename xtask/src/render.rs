@@ -179,7 +179,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     bar.finish_and_clear();
     write_outputs(&img, args)?;
     let samples = f64::from(img.width) * f64::from(img.height) * f64::from(img.spp);
-    println!(
+    outln!(
         "{} {} x {}, {} spp, {}, {:.2} s, {:.2} M samples/s -> {}",
         scene.name,
         img.width,
@@ -232,7 +232,7 @@ pub fn compare(reference: &Path, test: &Path) -> Result<(), String> {
         ));
     }
     let tm = FlipTonemap::for_reference(&a.pixels);
-    println!("RMSE {:.6}", rmse(&a.pixels, &b.pixels));
-    println!("FLIP {:.6} ({})", flip(&a.pixels, &b.pixels, a.width, a.height, &tm), tm.describe());
+    outln!("RMSE {:.6}", rmse(&a.pixels, &b.pixels));
+    outln!("FLIP {:.6} ({})", flip(&a.pixels, &b.pixels, a.width, a.height, &tm), tm.describe());
     Ok(())
 }

@@ -5,7 +5,7 @@ use std::path::Path;
 pub fn run(name: &str, obj: &Path) -> Result<(), String> {
     let scene = scene::Scene::builtin(name).map_err(|e| e.to_string())?;
     scene.write_obj(obj).map_err(|e| e.to_string())?;
-    println!(
+    outln!(
         "{}: {} objects, {} triangles -> {}",
         scene.name,
         scene.objects.len(),

@@ -21,17 +21,17 @@ pub fn run(extra: &[String]) -> Result<(), String> {
         if !extra.is_empty() {
             cmd.arg("--").args(extra);
         }
-        println!("xtask test: cargo {}", args.join(" "));
+        outln!("xtask test: cargo {}", args.join(" "));
         let status = cmd.status().map_err(|e| format!("cannot run cargo: {e}"))?;
         if !status.success() {
             return Err(format!("cargo {} failed ({status})", args.join(" ")));
         }
     }
     if extra.is_empty() {
-        println!("xtask test: cargo xtask validate --quick");
+        outln!("xtask test: cargo xtask validate --quick");
         // the command's own defaults, as a user gets them
         crate::validate::run(&clap::Parser::parse_from(["validate", "--quick"]))?;
     }
-    println!("xtask test: all passed in {:.0} s", start.elapsed().as_secs_f64());
+    outln!("xtask test: all passed in {:.0} s", start.elapsed().as_secs_f64());
     Ok(())
 }

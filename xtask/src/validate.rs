@@ -125,7 +125,7 @@ struct Stages {
 impl Stages {
     fn next(&mut self, what: &str) {
         self.done += 1;
-        println!("[{}/{}] {what} ({:.1} s)", self.done, self.total, self.start.elapsed().as_secs_f64());
+        outln!("[{}/{}] {what} ({:.1} s)", self.done, self.total, self.start.elapsed().as_secs_f64());
     }
 }
 
@@ -271,26 +271,26 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
     std::fs::write(&path, report.html(&args.out)?).map_err(|e| format!("{}: {e}", path.display()))?;
     for r in &rows {
         if let (Some(rm), Some(fl)) = (r.rmse, r.flip) {
-            println!("  {:<18} RMSE {rm:.4}  FLIP {fl:.4}  {:.2} s", r.name, r.seconds);
+            outln!("  {:<18} RMSE {rm:.4}  FLIP {fl:.4}  {:.2} s", r.name, r.seconds);
         }
     }
     for m in &mask_rows {
-        println!("  room {:<26} {:>7.3} % of pixels disagree  {:>7.2} ms", m.name, m.disagreement * 100.0, m.gpu_ms);
+        outln!("  room {:<26} {:>7.3} % of pixels disagree  {:>7.2} ms", m.name, m.disagreement * 100.0, m.gpu_ms);
     }
     for r in &size_rows {
-        println!(
+        outln!(
             "  room paraboloid_1024, widest edge {:.3} rad ({} triangles): {:.3} % disagree",
             r.widest,
             r.triangles,
             r.disagreement * 100.0
         );
     }
-    println!("report: {}", path.display());
+    outln!("report: {}", path.display());
     if checked == 0 {
-        println!("thresholds: none recorded for {key} (validate/thresholds.json)");
+        outln!("thresholds: none recorded for {key} (validate/thresholds.json)");
     }
     if failures.is_empty() {
-        println!("validate: {checked} thresholds met, done in {:.1} s", stages.start.elapsed().as_secs_f64());
+        outln!("validate: {checked} thresholds met, done in {:.1} s", stages.start.elapsed().as_secs_f64());
         Ok(())
     } else {
         Err(format!("validate: {} of {checked} thresholds exceeded:\n  {}", failures.len(), failures.join("\n  ")))

@@ -263,7 +263,7 @@ fn eval_lights_writes_both_tables_with_a_noise_floor() {
     let csv = std::fs::read_to_string(out_dir.join("eval-lights.csv")).expect("csv");
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines[0], "map,scene,method,lights,rmse,converged_rmse,flip,extract_ms");
-    assert_eq!(lines.len(), 1 + 11, "floor + five methods + three ablations + two above-horizon: {csv}");
+    assert_eq!(lines.len(), 1 + 13, "floor + five methods + three ablations + four of our options: {csv}");
     for ablation in ["emissive-split/no-masking", "emissive-split/no-kmeans", "emissive-split/neither"] {
         assert!(csv.contains(&format!(",{ablation},")), "{ablation} missing:\n{csv}");
     }
@@ -273,11 +273,25 @@ fn eval_lights_writes_both_tables_with_a_noise_floor() {
         "median-cut",
         "variance-min",
         "importance",
-        "(reference, other seed)",
+        "\"(reference, other seed)\"",
         "emissive-split+above-horizon",
+        "emissive-split+moment-cones",
+        "emissive-split+moment-cones+above-horizon",
         "median-cut+above-horizon",
     ] {
         assert!(csv.contains(&format!(",{method},")), "{method} missing:\n{csv}");
+    }
+    // every row has the header's 8 fields (commas inside quotes do not separate)
+    for line in &lines {
+        let mut quoted = false;
+        let fields = 1 + line
+            .chars()
+            .filter(|&c| {
+                quoted ^= c == '"';
+                c == ',' && !quoted
+            })
+            .count();
+        assert_eq!(fields, 8, "{line}");
     }
     let md = std::fs::read_to_string(out_dir.join("eval-lights.md")).expect("md");
     assert!(md.contains("| median-cut |") && md.contains("RMSE / median cut"), "{md}");

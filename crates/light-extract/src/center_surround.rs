@@ -297,6 +297,14 @@ impl CenterSurround {
 }
 
 impl LightExtractor for CenterSurround {
+    fn budget(&self) -> Option<usize> {
+        Some(self.max_lights)
+    }
+
+    fn with_budget(&self, lights: usize) -> Option<Box<dyn LightExtractor>> {
+        Some(Box::new(Self { max_lights: lights, ..*self }))
+    }
+
     fn extract(&self, map: &EnvMap) -> Result<Decomposition, ExtractError> {
         self.check()?;
         let start = Instant::now();

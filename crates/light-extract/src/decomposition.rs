@@ -155,10 +155,29 @@ pub trait LightExtractor {
     /// # Errors
     /// [`ExtractError::Parameter`] when a parameter is out of range.
     fn extract(&self, map: &EnvMap) -> Result<Decomposition, ExtractError>;
+
+    /// The light budget K, for methods that take one.
+    fn budget(&self) -> Option<usize> {
+        None
+    }
+
+    /// The same extractor with a budget of `lights` (`None` for methods without a budget).
+    fn with_budget(&self, lights: usize) -> Option<Box<dyn LightExtractor>> {
+        let _ = lights;
+        None
+    }
 }
 
 impl<T: LightExtractor + ?Sized> LightExtractor for Box<T> {
     fn extract(&self, map: &EnvMap) -> Result<Decomposition, ExtractError> {
         (**self).extract(map)
+    }
+
+    fn budget(&self) -> Option<usize> {
+        (**self).budget()
+    }
+
+    fn with_budget(&self, lights: usize) -> Option<Box<dyn LightExtractor>> {
+        (**self).with_budget(lights)
     }
 }

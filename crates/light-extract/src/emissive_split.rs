@@ -57,6 +57,10 @@ pub struct EmissiveSplit {
     pub leaf_resolution: u32,
     /// Seed of the EnvDirects sampling.
     pub seed: u64,
+    /// Our option, not the paper's (off by default): give each light the cone whose angular
+    /// spread matches its cluster's energy-weighted spread (same power, same centroid) instead
+    /// of the cluster's whole solid angle, so a sun with a faint halo casts a sun's penumbra.
+    pub moment_cones: bool,
 }
 
 impl Default for EmissiveSplit {
@@ -76,6 +80,7 @@ impl Default for EmissiveSplit {
             w_e: 1.0,
             leaf_resolution: 128,
             seed: 0,
+            moment_cones: false,
         }
     }
 }
@@ -86,29 +91,50 @@ struct Cluster {
     power: DVec3,
     weighted_dir: DVec3,
     solid_angle: f64,
-    members: Vec<DVec3>,
+    /// (direction, luminance x solid angle, solid angle) per member
+    members: Vec<(DVec3, f64, f64)>,
 }
 
 impl Cluster {
     fn add(&mut self, dir: DVec3, rgb: DVec3, sa: f64) {
+        let w = luminance_f64(rgb.to_array()) * sa;
         self.power += rgb * sa;
-        self.weighted_dir += dir * luminance_f64(rgb.to_array()) * sa;
+        self.weighted_dir += dir * w;
         self.solid_angle += sa;
-        self.members.push(dir);
+        self.members.push((dir, w, sa));
     }
 
-    fn light(&self) -> Option<ExtractedLight> {
+    /// The cone standing for the cluster: its whole solid angle, or with `moment_cone` the cone
+    /// of equal energy-weighted mean of 1 - cos(angle to the centre). A uniform cone of
+    /// solid angle W has that mean W / 4 pi, and a texel of solid angle w adds its own w / 4 pi.
+    fn light(&self, moment_cone: bool) -> Option<ExtractedLight> {
         let brightest = self.power.max_element();
         if brightest.is_nan() || brightest <= 0.0 || self.solid_angle <= 0.0 {
             return None;
         }
-        let c = self.weighted_dir.try_normalize().or_else(|| self.members.iter().sum::<DVec3>().try_normalize())?;
-        let extent = self.members.iter().map(|d| c.dot(*d).clamp(-1.0, 1.0).acos()).fold(0.0, f64::max);
+        let c = self
+            .weighted_dir
+            .try_normalize()
+            .or_else(|| self.members.iter().map(|m| m.0).sum::<DVec3>().try_normalize())?;
+        let extent = self.members.iter().map(|(d, ..)| c.dot(*d).clamp(-1.0, 1.0).acos()).fold(0.0, f64::max);
+        let total: f64 = self.members.iter().map(|m| m.1.max(0.0)).sum();
+        let solid_angle = if moment_cone && total > 0.0 {
+            let four_pi = 4.0 * std::f64::consts::PI;
+            let spread: f64 = self
+                .members
+                .iter()
+                .map(|&(d, w, sa)| w.max(0.0) * ((1.0 - c.dot(d)).max(0.0) + sa / four_pi))
+                .sum::<f64>()
+                / total;
+            (four_pi * spread).min(four_pi)
+        } else {
+            self.solid_angle
+        };
         Some(ExtractedLight {
             light: DistantLight {
                 direction: c.as_vec3(),
-                solid_angle: self.solid_angle as f32,
-                radiance: (self.power / self.solid_angle).as_vec3(),
+                solid_angle: solid_angle as f32,
+                radiance: (self.power / solid_angle).as_vec3(),
             },
             extent: extent as f32,
         })
@@ -173,6 +199,14 @@ impl EmissiveSplit {
 }
 
 impl LightExtractor for EmissiveSplit {
+    fn budget(&self) -> Option<usize> {
+        Some(self.lights)
+    }
+
+    fn with_budget(&self, lights: usize) -> Option<Box<dyn LightExtractor>> {
+        Some(Box::new(Self { lights, ..*self }))
+    }
+
     fn extract(&self, map: &EnvMap) -> Result<Decomposition, ExtractError> {
         self.check()?;
         let start = Instant::now();
@@ -277,7 +311,7 @@ impl LightExtractor for EmissiveSplit {
                 true
             });
         }
-        let directs: Vec<ExtractedLight> = clusters.iter().filter_map(Cluster::light).collect();
+        let directs: Vec<ExtractedLight> = clusters.iter().filter_map(|c| c.light(self.moment_cones)).collect();
         // Section 3.4: EnvIndirects over the rest, on a light tree of downsampled leaves.
         let m = self.lights.saturating_sub(directs.len());
         let mut masked = map.clone();
@@ -326,7 +360,7 @@ impl LightExtractor for EmissiveSplit {
                 for leaf in &leaves[nodes[id].lo..nodes[id].hi] {
                     cl.add(leaf.dir, leaf.rgb, leaf.sa);
                 }
-                indirects.extend(cl.light());
+                indirects.extend(cl.light(self.moment_cones));
             }
         }
         let n_directs = directs.len();
@@ -336,10 +370,11 @@ impl LightExtractor for EmissiveSplit {
             "lights": self.lights, "lambda": self.lambda, "gamma": self.gamma, "percentile": self.percentile,
             "a": self.a, "b": self.b, "s": self.s, "masking": self.masking, "kmeans": self.kmeans,
             "w_v": self.w_v, "w_d": self.w_d, "w_e": self.w_e, "leaf_resolution": self.leaf_resolution,
-            "seed": self.seed, "threshold": l_t, "env_directs": n_directs,
+            "seed": self.seed, "moment_cones": self.moment_cones, "threshold": l_t, "env_directs": n_directs,
         });
         let ambient = EnvMap::constant(w, h, Vec3::ZERO);
-        let mut d = Decomposition::new("emissive-split", params, map, lights, ambient, true);
+        let name = if self.moment_cones { "emissive-split+moment-cones" } else { "emissive-split" };
+        let mut d = Decomposition::new(name, params, map, lights, ambient, true);
         d.time_ms = start.elapsed().as_secs_f64() * 1e3;
         Ok(d)
     }

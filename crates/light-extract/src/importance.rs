@@ -36,6 +36,14 @@ fn radical_inverse_base2(k: u32) -> f32 {
 }
 
 impl LightExtractor for ImportanceSampled {
+    fn budget(&self) -> Option<usize> {
+        Some(self.count)
+    }
+
+    fn with_budget(&self, lights: usize) -> Option<Box<dyn LightExtractor>> {
+        Some(Box::new(Self { count: lights, ..*self }))
+    }
+
     fn extract(&self, map: &EnvMap) -> Result<Decomposition, ExtractError> {
         if self.count == 0 || self.count > 1 << 20 {
             return Err(ExtractError::Parameter(format!(

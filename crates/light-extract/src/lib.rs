@@ -42,7 +42,7 @@ pub mod overlay;
 mod regions;
 mod variance;
 
-pub use above_horizon::{AboveHorizon, upper_hemisphere};
+pub use above_horizon::{AboveHorizon, narrow_to_horizon, upper_hemisphere};
 pub use center_surround::CenterSurround;
 pub use decomposition::{
     Decomposition, ExtractError, ExtractedLight, INTERLEAVED_JITTER, INTERLEAVED_SETS, LightExtractor, interleaved_sets,
@@ -55,13 +55,22 @@ pub use variance::VarianceMinimization;
 /// The methods by name, as `lights.json` and the commands name them.
 pub const METHODS: [&str; 5] = ["emissive-split", "center-surround", "median-cut", "variance-min", "importance"];
 
-/// The extractor named `method` (one of [`METHODS`], optionally followed by `+above-horizon`)
-/// with a budget of `k` lights and the papers' defaults otherwise; `None` for an unknown name.
+/// Our options (not the papers'), appended to a method's name with `+`: `moment-cones`
+/// (emissive split only, [`EmissiveSplit::moment_cones`]), then `above-horizon` (any method,
+/// [`AboveHorizon`]).
+pub const OPTIONS: [&str; 2] = ["moment-cones", "above-horizon"];
+
+/// The extractor named `method` (one of [`METHODS`], optionally followed by [`OPTIONS`] in that
+/// order, e.g. `emissive-split+moment-cones+above-horizon`) with a budget of `k` lights and the
+/// papers' defaults otherwise; `None` for an unknown name or option.
 #[must_use]
 pub fn extractor(method: &str, k: usize) -> Option<Box<dyn LightExtractor>> {
     let (base, above_horizon) = method.strip_suffix("+above-horizon").map_or((method, false), |b| (b, true));
     let inner: Box<dyn LightExtractor> = match base {
         "emissive-split" => Box::new(EmissiveSplit { lights: k, ..EmissiveSplit::default() }),
+        "emissive-split+moment-cones" => {
+            Box::new(EmissiveSplit { lights: k, moment_cones: true, ..EmissiveSplit::default() })
+        }
         "center-surround" => Box::new(CenterSurround { max_lights: k, ..CenterSurround::default() }),
         "median-cut" => Box::new(MedianCut::with_lights(k)),
         "variance-min" => Box::new(VarianceMinimization::with_lights(k)),

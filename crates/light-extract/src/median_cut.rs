@@ -70,6 +70,14 @@ fn split(sat: &SummedAreaTable<1>, r: Region, w: u32, h: u32) -> Option<(Region,
 }
 
 impl LightExtractor for MedianCut {
+    fn budget(&self) -> Option<usize> {
+        Some(1 << self.depth)
+    }
+
+    fn with_budget(&self, lights: usize) -> Option<Box<dyn LightExtractor>> {
+        Some(Box::new(Self::with_lights(lights)))
+    }
+
     fn extract(&self, map: &EnvMap) -> Result<Decomposition, ExtractError> {
         if self.depth > 24 {
             return Err(ExtractError::Parameter(format!("median cut depth {} > 24", self.depth)));

@@ -60,6 +60,14 @@ fn split(sat: &SummedAreaTable<4>, r: Region) -> Option<(Region, Region)> {
 }
 
 impl LightExtractor for VarianceMinimization {
+    fn budget(&self) -> Option<usize> {
+        Some(1 << self.depth)
+    }
+
+    fn with_budget(&self, lights: usize) -> Option<Box<dyn LightExtractor>> {
+        Some(Box::new(Self::with_lights(lights)))
+    }
+
     fn extract(&self, map: &EnvMap) -> Result<Decomposition, ExtractError> {
         if self.depth > 24 {
             return Err(ExtractError::Parameter(format!("variance minimization depth {} > 24", self.depth)));

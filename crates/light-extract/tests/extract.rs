@@ -442,3 +442,98 @@ fn above_horizon_drops_only_the_lower_hemisphere() {
         }));
     }
 }
+
+#[test]
+fn above_horizon_fills_the_budget_on_every_shared_map() {
+    use light_extract::AboveHorizon;
+    let mut short_without = 0;
+    for path in shared_maps() {
+        let map = EnvMap::load(&path).unwrap();
+        let es = EmissiveSplit { lights: 32, ..EmissiveSplit::default() };
+        let plain = AboveHorizon { fill_budget: false, ..AboveHorizon::new(es) }.extract(&map).unwrap();
+        let filled = AboveHorizon::new(es).extract(&map).unwrap();
+        short_without += usize::from(plain.lights.len() < 32);
+        assert!(filled.lights.len() <= 32 && filled.lights.len() >= plain.lights.len(), "{}", path.display());
+        assert!(filled.lights.len() >= 31, "{}: {} of 32 lights", path.display(), filled.lights.len());
+        assert!(filled.power_balance_error() < 1e-4, "{}", path.display());
+        assert!(filled.params["inner_budget"].as_u64().unwrap() >= 32);
+    }
+    // the paper's light tree does lose budget on the empty half, so filling is tested
+    assert!(short_without > 0);
+}
+
+#[test]
+fn moment_cones_match_a_uniform_cap_and_shrink_a_haloed_sun() {
+    let es = EmissiveSplit { lights: 8, ..EmissiveSplit::default() };
+    let moment = EmissiveSplit { moment_cones: true, ..es };
+    // a uniform cap of 5 degrees (inside one masking radius: one light): the cone of equal
+    // spread is the cap itself
+    let axis = Vec3::new(0.2, 0.5, -0.8).normalize();
+    let cap_cos = 5f32.to_radians().cos();
+    let map =
+        EnvMap::from_fn(1024, 512, |d| if d.dot(axis) > cap_cos { Vec3::splat(500.0) } else { Vec3::splat(0.01) });
+    let cap_sa = 2.0 * std::f32::consts::PI * (1.0 - cap_cos);
+    let d = moment.extract(&map).unwrap();
+    let sun = d.lights.iter().max_by(|a, b| a.power().x.total_cmp(&b.power().x)).unwrap();
+    assert!(sun.light.direction.angle_between(axis) < 0.01, "{sun:?}");
+    assert!((sun.light.solid_angle / cap_sa - 1.0).abs() < 0.05, "{} vs {cap_sa}", sun.light.solid_angle);
+    // a one-texel sun in a faint halo: same power and direction, a far smaller cone
+    let sun_dir = map.texel_dir(300, 100);
+    let halo = EnvMap::from_fn(1024, 512, |d| {
+        let a = d.angle_between(sun_dir);
+        if a < 0.004 {
+            Vec3::splat(60000.0)
+        } else if a < 0.15 {
+            Vec3::splat(40.0)
+        } else {
+            Vec3::splat(0.05)
+        }
+    });
+    let (p, m) = (es.extract(&halo).unwrap(), moment.extract(&halo).unwrap());
+    assert_eq!(p.lights.len(), m.lights.len());
+    assert!(m.power_balance_error() < 1e-4);
+    for (a, b) in p.lights.iter().zip(&m.lights) {
+        assert_eq!(a.light.direction, b.light.direction);
+        assert!((a.power() - b.power()).abs().max_element() <= 1e-4 * a.power().max_element());
+    }
+    let brightest = |d: &Decomposition| *d.lights.iter().max_by(|a, b| a.power().x.total_cmp(&b.power().x)).unwrap();
+    let (ps, ms) = (brightest(&p), brightest(&m));
+    assert!(ms.light.solid_angle < 0.25 * ps.light.solid_angle, "{ms:?} vs {ps:?}");
+    no_nan(&m);
+}
+
+#[test]
+fn cones_crossing_the_horizon_are_narrowed_to_it() {
+    use light_extract::{AboveHorizon, narrow_to_horizon};
+    use scene::DistantLight;
+    // a low sun in a bright horizon band: its cluster straddles the horizon
+    let sun = Vec3::new(0.6, 0.05, 0.8).normalize();
+    let map = EnvMap::from_fn(1024, 512, |d| {
+        if d.dot(sun) > 0.9995 {
+            Vec3::splat(3000.0)
+        } else if d.y.abs() < 0.1 {
+            Vec3::splat(20.0)
+        } else {
+            Vec3::splat(0.5)
+        }
+    });
+    let es = EmissiveSplit { lights: 16, ..EmissiveSplit::default() };
+    let wide = AboveHorizon { narrow_at_horizon: false, ..AboveHorizon::new(es) }.extract(&map).unwrap();
+    let narrow = AboveHorizon::new(es).extract(&map).unwrap();
+    let crossing = |l: &light_extract::ExtractedLight| l.light.half_angle() > l.light.direction.y.asin() + 1e-4;
+    assert!(wide.lights.iter().any(crossing), "the test needs a cone across the horizon");
+    assert!(!narrow.lights.iter().any(crossing));
+    assert_eq!(wide.lights.len(), narrow.lights.len());
+    for (a, b) in wide.lights.iter().zip(&narrow.lights) {
+        assert_eq!(a.light.direction, b.light.direction);
+        assert!((a.power() - b.power()).abs().max_element() <= 1e-5 * a.power().max_element());
+    }
+    assert!(narrow.power_balance_error() < 1e-4);
+    no_nan(&narrow);
+    // a sun a hair above the horizon: a tiny but finite cone
+    let mut l =
+        DistantLight { direction: Vec3::new(1.0, 1e-6, 0.0).normalize(), solid_angle: 0.01, radiance: Vec3::ONE };
+    narrow_to_horizon(&mut l, Vec3::Y);
+    assert!(l.solid_angle > 0.0 && l.radiance.is_finite(), "{l:?}");
+    assert!((l.power() - Vec3::splat(0.01)).abs().max_element() < 1e-6);
+}

@@ -3,8 +3,8 @@
 //! - `EnvDirect`: direct illumination from the map, multiple importance sampling of one map
 //!   sample and one BRDF sample with the power heuristic; the truth approximations are measured
 //!   against. `Strategy` isolates either technique for tests.
-//! - `Lights`: direct illumination from distant cone lights with ray-traced visibility, plus an
-//!   SH9 ambient term (unshadowed, or shadowed by cosine-sampled visibility).
+//! - `Lights`: direct illumination from distant cone lights with ray-traced visibility (cone
+//!   sampling, combined by MIS with a BRDF sample on glossy surfaces), plus an SH9 ambient term (unshadowed, or shadowed by cosine-sampled visibility).
 //! - `Path`: multi-bounce path tracing with the same MIS next-event estimation at every vertex.
 //!
 //! Surfaces do not emit; the map is the only light of `EnvDirect` and `Path`.
@@ -206,11 +206,16 @@ fn lights_direct(bvh: &SceneBvh, set: &LightSet, sh: &Shading, s: &mut PixelSamp
         let k = (s.sample_index() % (set.interleaved.len() as u64 + 1)) as usize;
         if k == 0 { set.lights } else { &set.interleaved[k - 1] }
     };
+    // A glossy lobe narrower than a cone makes cone sampling noisy: there each light combines
+    // its cone sample with one BRDF sample shared by all lights (power heuristic, one sample of
+    // each technique per light). Lambertian surfaces keep cone sampling alone.
+    let glossy = sh.material.specular.is_some();
     for light in lights {
         let (dir, pdf) = light.sample_direction(s.next_2d());
-        let (fc, _) = sh.f_cos(dir);
+        let (fc, wi) = sh.f_cos(dir);
         if fc != Vec3::ZERO && !bvh.occluded(sh.origin(), dir, f32::INFINITY) {
-            l += fc * light.radiance / pdf;
+            let w = if glossy { power_heuristic(pdf, sh.material.brdf_pdf(sh.wo, wi)) } else { 1.0 };
+            l += fc * light.radiance * (w / pdf);
         }
     }
     if let Some(sh9) = &set.ambient {
@@ -223,6 +228,17 @@ fn lights_direct(bvh: &SceneBvh, set: &LightSet, sh: &Shading, s: &mut PixelSamp
             }
         } else {
             l += diffuse * sh9.irradiance(sh.frame.n).max(Vec3::ZERO) * std::f32::consts::FRAC_1_PI;
+        }
+    }
+    if glossy && let Some((wi, pdf)) = sh.material.sample_brdf(sh.wo, s.next_2d(), s.next_1d()) {
+        let wi_world = sh.frame.to_world(wi);
+        let (fc, _) = sh.f_cos(wi_world);
+        let mut seen = Vec3::ZERO;
+        for light in lights.iter().filter(|light| light.contains(wi_world)) {
+            seen += light.radiance * power_heuristic(pdf, 1.0 / light.solid_angle);
+        }
+        if fc != Vec3::ZERO && seen != Vec3::ZERO && !bvh.occluded(sh.origin(), wi_world, f32::INFINITY) {
+            l += fc * seen / pdf;
         }
     }
     l

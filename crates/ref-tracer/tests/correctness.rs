@@ -316,3 +316,44 @@ fn every_builtin_scene_renders_finite_images_with_aovs() {
         }
     }
 }
+
+#[test]
+fn glossy_lights_match_the_map_of_their_cones() {
+    // Two overlapping cones over glossy objects (the lights integrator combines cone and BRDF
+    // samples there) against env-direct of a map holding exactly those cones.
+    let scene = small("glossy_set", 40, 30);
+    let a =
+        DistantLight { direction: Vec3::new(0.3, 0.8, 0.5).normalize(), solid_angle: 0.2, radiance: Vec3::splat(2.0) };
+    let b =
+        DistantLight { direction: Vec3::new(0.4, 0.7, 0.6).normalize(), solid_angle: 0.05, radiance: Vec3::splat(5.0) };
+    let map =
+        EnvMap::from_fn(2048, 1024, |d| [a, b].iter().filter(|l| l.contains(d)).map(|l| l.radiance).sum::<Vec3>());
+    let lights = [a, b];
+    let set = || LightSet { lights: &lights, interleaved: &[], ambient: None, shadow_ambient: false, background: None };
+    let objects = [(3u32, "semi_glossy_sphere"), (4, "glossy_box")];
+    let stats = |integrator: &Integrator, spp: u32| {
+        let runs: Vec<Vec<Vec3>> = (0..6)
+            .map(|seed| {
+                let r = run(&scene, Some(&map), integrator, spp, 40 + seed);
+                objects.iter().map(|(o, _)| object_mean(&r, *o).0).collect()
+            })
+            .collect();
+        objects
+            .iter()
+            .enumerate()
+            .map(|(k, _)| {
+                let v: Vec<f64> = runs.iter().map(|r| f64::from(envmap_sphere::luminance(r[k]))).collect();
+                let m = v.iter().sum::<f64>() / v.len() as f64;
+                let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len() - 1) as f64;
+                (m, (var / v.len() as f64).sqrt())
+            })
+            .collect::<Vec<_>>()
+    };
+    let lit = stats(&Integrator::Lights(set()), 16);
+    let truth = stats(&Integrator::EnvDirect(Strategy::Mis), 64);
+    for (((m1, e1), (m2, e2)), (_, name)) in lit.iter().zip(&truth).zip(&objects) {
+        // 1 %: the map's texels only approximate the cones' edges
+        let tolerance = 3.0 * (e1 * e1 + e2 * e2).sqrt() + 0.01 * m2;
+        assert!((m1 - m2).abs() < tolerance, "{name}: lights {m1} vs map {m2} (sigmas {e1}, {e2})");
+    }
+}
