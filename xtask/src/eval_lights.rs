@@ -104,8 +104,14 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
             // Every render goes through the same lights_spp sub-pixel positions, so a method's
             // error holds no antialiasing noise, only its lighting error and lighting noise.
             let positions = Some(args.lights_spp.max(1));
-            let truth =
-                RenderSettings { spp: args.spp, seed: 1, time_budget: None, aovs: false, pixel_positions: positions };
+            let truth = RenderSettings {
+                spp: args.spp,
+                seed: 1,
+                time_budget: None,
+                aovs: false,
+                pixel_positions: positions,
+                ..RenderSettings::default()
+            };
             let reference =
                 ref_tracer::render(&scene, &bvh, Some(&env), &Integrator::EnvDirect(Strategy::Mis), &truth, &|_, _| {});
             bar.inc(1);
@@ -145,6 +151,7 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
                     time_budget: None,
                     aovs: false,
                     pixel_positions: positions,
+                    ..RenderSettings::default()
                 };
                 let img = ref_tracer::render(&scene, &bvh, None, &Integrator::Lights(set), &settings, &|_, _| {});
                 bar.inc(1);

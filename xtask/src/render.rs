@@ -5,7 +5,7 @@ use crate::parse_size;
 use envmap_sphere::{EnvMap, Sh9, Tonemap};
 use glam::Vec3;
 use ref_tracer::metrics::{FlipTonemap, flip, rmse};
-use ref_tracer::{EnvLight, Integrator, LightSet, RenderSettings, SceneBvh, Strategy};
+use ref_tracer::{EnvLight, Integrator, LightSet, RenderSettings, SamplerKind, SceneBvh, Strategy};
 use scene::{DistantLight, Scene};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -54,6 +54,9 @@ pub struct RenderArgs {
     /// for every seed), so that renders compared with `compare` differ only in their lighting.
     #[arg(long)]
     pub pixel_positions: Option<u32>,
+    /// Sample points: sobol (Owen-scrambled Sobol, stratified) or independent (plain Monte Carlo).
+    #[arg(long, default_value = "sobol")]
+    pub sampler: String,
 }
 
 /// The map from `--envmap`, or the embedded default.
@@ -172,6 +175,11 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         time_budget: args.time_budget.map(Duration::from_secs_f64),
         aovs: args.aovs,
         pixel_positions: args.pixel_positions,
+        sampler: match args.sampler.as_str() {
+            "sobol" => SamplerKind::Sobol,
+            "independent" => SamplerKind::Independent,
+            other => return Err(format!("unknown sampler {other:?}; available: sobol, independent")),
+        },
     };
     let img = ref_tracer::render(&scene, &bvh, Some(&env), &integrator, &settings, &|done, _| {
         bar.set_position(u64::from(done))

@@ -153,8 +153,14 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
     let bvh = SceneBvh::new(&scene);
     let env = EnvLight::new(&map);
     let t = Instant::now();
-    let settings =
-        RenderSettings { spp: plan.reference_spp, seed: 1, time_budget: None, aovs: false, pixel_positions: None };
+    let settings = RenderSettings {
+        spp: plan.reference_spp,
+        seed: 1,
+        time_budget: None,
+        aovs: false,
+        pixel_positions: None,
+        ..RenderSettings::default()
+    };
     let reference =
         ref_tracer::render(&scene, &bvh, Some(&env), &Integrator::EnvDirect(Strategy::Mis), &settings, &|_, _| {});
     let reference_s = t.elapsed().as_secs_f64();
@@ -168,8 +174,14 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
         shadow_ambient: false,
         background: Some(&map),
     };
-    let settings =
-        RenderSettings { spp: plan.lights_spp, seed: 2, time_budget: None, aovs: false, pixel_positions: None };
+    let settings = RenderSettings {
+        spp: plan.lights_spp,
+        seed: 2,
+        time_budget: None,
+        aovs: false,
+        pixel_positions: None,
+        ..RenderSettings::default()
+    };
     let traced = ref_tracer::render(&scene, &bvh, None, &Integrator::Lights(set), &settings, &|_, _| {});
     let traced_s = t.elapsed().as_secs_f64();
 

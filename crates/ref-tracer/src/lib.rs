@@ -3,7 +3,8 @@
 //!
 //! - Deterministic: every (seed, pixel, sample) has its own random stream, so the same seed
 //!   gives the same image bits for any thread count.
-//! - Box pixel filter: a pixel is the plain mean of its samples, jittered uniformly.
+//! - Box pixel filter: a pixel is the plain mean of its samples, jittered uniformly (and
+//!   stratified: Owen-scrambled Sobol points by default, see [`sampler`]).
 //! - Integrators ([`Integrator`]): `EnvDirect` (MIS of the map and the BRDF, the truth for
 //!   direct light), `Lights` (extracted cone lights with ray-traced visibility plus SH9 ambient)
 //!   and `Path` (multi-bounce).
@@ -17,7 +18,7 @@
 //! let map = envmap_sphere::default_map().resize(64, 32);
 //! let env = EnvLight::new(&map);
 //! let bvh = SceneBvh::new(&scene);
-//! let settings = RenderSettings { spp: 2, seed: 1, time_budget: None, aovs: true, pixel_positions: None };
+//! let settings = RenderSettings { spp: 2, seed: 1, time_budget: None, aovs: true, pixel_positions: None, ..RenderSettings::default() };
 //! let img = render(&scene, &bvh, Some(&env), &Integrator::EnvDirect(Strategy::Mis), &settings, &|_, _| {});
 //! assert_eq!((img.width, img.height, img.spp), (32, 24, 2));
 //! assert!(img.color.iter().all(|c| c.is_finite()));
@@ -35,3 +36,4 @@ pub mod visibility;
 pub use bvh::{SceneBvh, SurfacePoint};
 pub use integrator::{EnvLight, Integrator, LightSet, Strategy};
 pub use render::{Render, RenderSettings, render};
+pub use sampler::SamplerKind;

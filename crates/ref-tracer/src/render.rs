@@ -3,7 +3,7 @@
 
 use crate::bvh::SceneBvh;
 use crate::integrator::{EnvLight, Integrator};
-use crate::sampler::PixelSampler;
+use crate::sampler::{PixelSampler, SamplerKind};
 use glam::Vec3;
 use rayon::prelude::*;
 use scene::Scene;
@@ -28,11 +28,13 @@ pub struct RenderSettings {
     /// holds no antialiasing noise (for comparing light approximations against a truth). `None`:
     /// a fresh jittered position per sample (the box filter's unbiased estimate).
     pub pixel_positions: Option<u32>,
+    /// How sample points are drawn: stratified Sobol (the default) or independent.
+    pub sampler: SamplerKind,
 }
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        Self { spp: 16, seed: 0, time_budget: None, aovs: true, pixel_positions: None }
+        Self { spp: 16, seed: 0, time_budget: None, aovs: true, pixel_positions: None, sampler: SamplerKind::Sobol }
     }
 }
 
@@ -94,11 +96,10 @@ pub fn render(
                         let pixel = (y * w + x) as usize;
                         let mut acc = Vec3::ZERO;
                         for k in done..done + count {
-                            let mut s = PixelSampler::new(settings.seed, pixel as u64, u64::from(k));
+                            let sampler = |seed, k| PixelSampler::with_kind(settings.sampler, seed, pixel as u64, k);
+                            let mut s = sampler(settings.seed, u64::from(k));
                             let j = match settings.pixel_positions {
-                                Some(n) => {
-                                    PixelSampler::new(POSITIONS_SEED, pixel as u64, u64::from(k % n.max(1))).next_2d()
-                                }
+                                Some(n) => sampler(POSITIONS_SEED, u64::from(k % n.max(1))).next_2d(),
                                 None => s.next_2d(),
                             };
                             let (o, d) = cam.ray(x as f32 + j.x, y as f32 + j.y);

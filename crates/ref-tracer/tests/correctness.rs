@@ -3,7 +3,9 @@
 
 use envmap_sphere::{EnvMap, Sh9};
 use glam::Vec3;
-use ref_tracer::{EnvLight, Integrator, LightSet, Render, RenderSettings, SceneBvh, Strategy, metrics, render};
+use ref_tracer::{
+    EnvLight, Integrator, LightSet, Render, RenderSettings, SamplerKind, SceneBvh, Strategy, metrics, render,
+};
 use scene::{Camera, DistantLight, Material, Mesh, Object, Scene};
 
 fn small(name: &str, w: u32, h: u32) -> Scene {
@@ -18,7 +20,14 @@ fn run(scene: &Scene, map: Option<&EnvMap>, integrator: &Integrator, spp: u32, s
         scene,
         map,
         integrator,
-        &RenderSettings { spp, seed, time_budget: None, aovs: true, pixel_positions: None },
+        &RenderSettings {
+            spp,
+            seed,
+            time_budget: None,
+            aovs: true,
+            pixel_positions: None,
+            ..RenderSettings::default()
+        },
     )
 }
 
@@ -152,13 +161,26 @@ fn rmse_halves_for_every_four_times_the_samples() {
     let map = envmap_sphere::default_map().resize(32, 16);
     let integrator = Integrator::EnvDirect(Strategy::Mis);
     let reference = run(&scene, Some(&map), &integrator, 8192, 999);
-    let errors: Vec<f64> = [8, 32, 128]
-        .iter()
-        .map(|&spp| metrics::rmse(&reference.color, &run(&scene, Some(&map), &integrator, spp, 5).color))
-        .collect();
-    for pair in errors.windows(2) {
+    let errors = |sampler: SamplerKind| -> Vec<f64> {
+        [8, 32, 128]
+            .iter()
+            .map(|&spp| {
+                let settings = RenderSettings { spp, seed: 5, sampler, ..RenderSettings::default() };
+                metrics::rmse(&reference.color, &run_with(&scene, Some(&map), &integrator, &settings).color)
+            })
+            .collect()
+    };
+    // plain Monte Carlo: exactly the 1/sqrt(spp) law
+    let independent = errors(SamplerKind::Independent);
+    for pair in independent.windows(2) {
         let ratio = pair[0] / pair[1];
-        assert!((ratio / 2.0 - 1.0).abs() < 0.15, "RMSE {errors:?}: ratio {ratio}");
+        assert!((ratio / 2.0 - 1.0).abs() < 0.15, "RMSE {independent:?}: ratio {ratio}");
+    }
+    // stratified Sobol points: at least as fast, and below Monte Carlo at every count
+    let sobol = errors(SamplerKind::Sobol);
+    for (pair, (s, i)) in sobol.windows(2).zip(sobol.iter().zip(&independent)) {
+        assert!(pair[0] / pair[1] > 2.0 * 0.85, "RMSE {sobol:?}");
+        assert!(s < i, "Sobol {sobol:?} vs independent {independent:?}");
     }
 }
 
@@ -217,8 +239,14 @@ fn shared_pixel_positions_leave_no_antialiasing_noise() {
     let sh = Sh9::project(&envmap_sphere::default_map());
     let set = || LightSet { lights: &[], interleaved: &[], ambient: Some(sh), shadow_ambient: false, background: None };
     let scene = small("spheres_box", 40, 30);
-    let settings =
-        |seed, pixel_positions| RenderSettings { spp: 4, seed, time_budget: None, aovs: false, pixel_positions };
+    let settings = |seed, pixel_positions| RenderSettings {
+        spp: 4,
+        seed,
+        time_budget: None,
+        aovs: false,
+        pixel_positions,
+        ..RenderSettings::default()
+    };
     let a = run_with(&scene, None, &Integrator::Lights(set()), &settings(1, Some(4)));
     let b = run_with(&scene, None, &Integrator::Lights(set()), &settings(2, Some(4)));
     assert_eq!(a.color, b.color, "the same positions for any seed");
