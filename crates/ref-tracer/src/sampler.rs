@@ -59,19 +59,53 @@ fn owen_scramble(x: u32, seed: u32) -> u32 {
     laine_karras(x.reverse_bits(), seed).reverse_bits()
 }
 
-/// The first two Sobol dimensions of index `i` as 32-bit fractions: van der Corput, and the
-/// dimension of primitive polynomial x + 1 (direction numbers v_k = v_(k-1) ^ v_(k-1) >> 1).
-fn sobol_pair(mut i: u32) -> (u32, u32) {
-    let x = i.reverse_bits();
-    let (mut y, mut v) = (0u32, 1u32 << 31);
-    while i != 0 {
-        if i & 1 == 1 {
-            y ^= v;
-        }
-        i >>= 1;
-        v ^= v >> 1;
+/// Direction numbers of the second Sobol dimension (primitive polynomial x + 1):
+/// v_0 = 2^31, v_k = v_(k-1) ^ v_(k-1) >> 1.
+const fn direction_numbers() -> [u32; 32] {
+    let mut v = [0u32; 32];
+    v[0] = 1 << 31;
+    let mut k = 1;
+    while k < 32 {
+        v[k] = v[k - 1] ^ (v[k - 1] >> 1);
+        k += 1;
     }
-    (x, y)
+    v
+}
+
+/// The second dimension by bytes of the index: XOR of the direction numbers of a byte's set
+/// bits, for each of the four byte positions (4 KiB; one look-up per byte instead of a loop
+/// over 32 bits).
+const SOBOL_1_BYTES: [[u32; 256]; 4] = {
+    let v = direction_numbers();
+    let mut t = [[0u32; 256]; 4];
+    let mut byte = 0;
+    while byte < 4 {
+        let mut value = 0;
+        while value < 256 {
+            let (mut x, mut bit) = (0u32, 0);
+            while bit < 8 {
+                if value >> bit & 1 == 1 {
+                    x ^= v[byte * 8 + bit];
+                }
+                bit += 1;
+            }
+            t[byte][value] = x;
+            value += 1;
+        }
+        byte += 1;
+    }
+    t
+};
+
+/// The first two Sobol dimensions of index `i` as 32-bit fractions: van der Corput, and the
+/// dimension of primitive polynomial x + 1.
+fn sobol_pair(i: u32) -> (u32, u32) {
+    let b = i.to_le_bytes();
+    let y = SOBOL_1_BYTES[0][b[0] as usize]
+        ^ SOBOL_1_BYTES[1][b[1] as usize]
+        ^ SOBOL_1_BYTES[2][b[2] as usize]
+        ^ SOBOL_1_BYTES[3][b[3] as usize];
+    (i.reverse_bits(), y)
 }
 
 /// A 32-bit fraction as a float in [0, 1): its top 24 bits, exactly representable, never 1.
