@@ -18,14 +18,7 @@ fn env_direct(c: &mut Criterion) {
     group.bench_function("spheres_box_env_direct_640x480_1spp", |b| {
         b.iter(|| {
             seed += 1;
-            let settings = RenderSettings {
-                spp: 1,
-                seed,
-                time_budget: None,
-                aovs: false,
-                pixel_positions: None,
-                ..RenderSettings::default()
-            };
+            let settings = RenderSettings { spp: 1, seed, aovs: false, ..RenderSettings::default() };
             render(&scene, &bvh, Some(&env), &Integrator::EnvDirect(Strategy::Mis), &settings, &|_, _| {}).color.len()
         })
     });

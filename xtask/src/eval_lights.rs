@@ -81,6 +81,17 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
         )
         .map_err(|e| e.to_string())?,
     );
+    // the scenes and their BVHs, built once for every map
+    let scenes = args
+        .scenes
+        .iter()
+        .map(|name| {
+            let mut scene = scene::Scene::builtin(name).map_err(|e| e.to_string())?;
+            (scene.camera.width, scene.camera.height) = args.size;
+            let bvh = SceneBvh::new(&scene);
+            Ok((name, scene, bvh))
+        })
+        .collect::<Result<Vec<_>, String>>()?;
     let mut rows = Vec::new();
     for map_path in &maps {
         let map = load_map(Some(map_path))?;
@@ -96,10 +107,7 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
                 Ok::<_, String>((d, sets))
             })
             .collect::<Result<_, _>>()?;
-        for scene_name in &args.scenes {
-            let mut scene = scene::Scene::builtin(scene_name).map_err(|e| e.to_string())?;
-            (scene.camera.width, scene.camera.height) = args.size;
-            let bvh = SceneBvh::new(&scene);
+        for (scene_name, scene, bvh) in &scenes {
             bar.set_message(format!("{map_name} / {scene_name}"));
             // Every render goes through the same lights_spp sub-pixel positions, so a method's
             // error holds no antialiasing noise, only its lighting error and lighting noise.
@@ -107,19 +115,18 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
             let truth = RenderSettings {
                 spp: args.spp,
                 seed: 1,
-                time_budget: None,
                 aovs: false,
                 pixel_positions: positions,
-                ..RenderSettings::default()
+                ..Default::default()
             };
             let reference =
-                ref_tracer::render(&scene, &bvh, Some(&env), &Integrator::EnvDirect(Strategy::Mis), &truth, &|_, _| {});
+                ref_tracer::render(scene, bvh, Some(&env), &Integrator::EnvDirect(Strategy::Mis), &truth, &|_, _| {});
             bar.inc(1);
             let tm = FlipTonemap::for_reference(&reference.color);
             // The noise floor: the same truth with another seed.
             let again = RenderSettings { seed: 3, ..truth };
             let floor =
-                ref_tracer::render(&scene, &bvh, Some(&env), &Integrator::EnvDirect(Strategy::Mis), &again, &|_, _| {});
+                ref_tracer::render(scene, bvh, Some(&env), &Integrator::EnvDirect(Strategy::Mis), &again, &|_, _| {});
             bar.inc(1);
             // Two truths differ by twice the truth's noise variance.
             let floor_rmse = rmse(&reference.color, &floor.color);
@@ -127,7 +134,7 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
             let converged = |e: f64| (e * e - truth_variance).max(0.0).sqrt();
             rows.push(Row {
                 map: map_name.clone(),
-                scene: scene_name.clone(),
+                scene: scene_name.to_string(),
                 method: "(reference, other seed)".into(),
                 lights: 0,
                 rmse: floor_rmse,
@@ -145,20 +152,13 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
                     shadow_ambient: false,
                     background: Some(&map),
                 };
-                let settings = RenderSettings {
-                    spp: args.lights_spp.max(1),
-                    seed: 2,
-                    time_budget: None,
-                    aovs: false,
-                    pixel_positions: positions,
-                    ..RenderSettings::default()
-                };
-                let img = ref_tracer::render(&scene, &bvh, None, &Integrator::Lights(set), &settings, &|_, _| {});
+                let settings = RenderSettings { spp: args.lights_spp.max(1), seed: 2, ..truth };
+                let img = ref_tracer::render(scene, bvh, None, &Integrator::Lights(set), &settings, &|_, _| {});
                 bar.inc(1);
                 let error = rmse(&reference.color, &img.color);
                 rows.push(Row {
                     map: map_name.clone(),
-                    scene: scene_name.clone(),
+                    scene: scene_name.to_string(),
                     method: d.method.clone(),
                     lights: d.lights.len(),
                     rmse: error,

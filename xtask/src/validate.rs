@@ -153,14 +153,7 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
     let bvh = SceneBvh::new(&scene);
     let env = EnvLight::new(&map);
     let t = Instant::now();
-    let settings = RenderSettings {
-        spp: plan.reference_spp,
-        seed: 1,
-        time_budget: None,
-        aovs: false,
-        pixel_positions: None,
-        ..RenderSettings::default()
-    };
+    let settings = RenderSettings { spp: plan.reference_spp, seed: 1, aovs: false, ..RenderSettings::default() };
     let reference =
         ref_tracer::render(&scene, &bvh, Some(&env), &Integrator::EnvDirect(Strategy::Mis), &settings, &|_, _| {});
     let reference_s = t.elapsed().as_secs_f64();
@@ -174,21 +167,18 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
         shadow_ambient: false,
         background: Some(&map),
     };
-    let settings = RenderSettings {
-        spp: plan.lights_spp,
-        seed: 2,
-        time_budget: None,
-        aovs: false,
-        pixel_positions: None,
-        ..RenderSettings::default()
-    };
+    let settings = RenderSettings { spp: plan.lights_spp, seed: 2, ..settings };
     let traced = ref_tracer::render(&scene, &bvh, None, &Integrator::Lights(set), &settings, &|_, _| {});
     let traced_s = t.elapsed().as_secs_f64();
 
     stages.next("GPU: G-buffer, orthographic shadow maps, shading (lavapipe)");
     crate::lavapipe::ensure()?;
     let gpu = Gpu::new().map_err(|e| e.to_string())?;
-    let passes = Passes { gbuffer: GBufferPass::new(&gpu), shadows: ShadowMapper::new(&gpu) };
+    let passes = Passes {
+        gbuffer: GBufferPass::new(&gpu),
+        shadows: ShadowMapper::new(&gpu),
+        shading: ShadingPass::new(&gpu).map_err(|e| e.to_string())?,
+    };
     let (gpu_image, gpu_unshadowed, gpu_s, shadow_ms) = gpu_render(&gpu, &passes, &scene, &map, &decomposition, &plan)?;
 
     stages.next("room: point-light shadow maps against ray-traced visibility, and their speed");
@@ -342,6 +332,7 @@ type GpuImages = (Vec<Vec3>, Vec<Vec3>, f64, f64);
 struct Passes {
     gbuffer: GBufferPass,
     shadows: ShadowMapper,
+    shading: ShadingPass,
 }
 
 fn gpu_render(
@@ -376,7 +367,7 @@ fn gpu_render(
         shadow_ms += m.time.as_secs_f64() * 1e3;
         mapper.visibility(gpu, &m, &gb, &vis.layer(k as u32)).map_err(e)?;
     }
-    let pass = ShadingPass::new(gpu).map_err(e)?;
+    let pass = &passes.shading;
     let background = Background::upload(gpu, map).map_err(e)?;
     let params = ShadeParams { lights: &lights, ambient: Some(&d.ambient_sh), background: Some(&background) };
     let image = pass.render(gpu, &geometry, &gb, &params, &vis).map_err(e)?;

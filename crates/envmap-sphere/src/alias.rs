@@ -190,8 +190,7 @@ impl EnvAliasDistribution {
     #[inline]
     #[must_use]
     pub fn uv_pdf(&self, uv: Vec2) -> f32 {
-        let i = ((uv.x * self.width as f32) as usize).min(self.width as usize - 1);
-        let j = ((uv.y * self.height as f32) as usize).min(self.height as usize - 1);
-        self.cols[j * self.width as usize + i].pdf
+        let (i, j) = crate::latlong::latlong_uv_to_texel(uv, self.width, self.height);
+        self.cols[j as usize * self.width as usize + i as usize].pdf
     }
 }

@@ -258,9 +258,8 @@ impl EnvDistribution {
     /// caller that also looks up radiance convert the direction once.
     #[must_use]
     pub fn uv_pdf(&self, uv: Vec2) -> f32 {
-        let i = ((uv.x * self.width as f32) as usize).min(self.width as usize - 1);
-        let j = ((uv.y * self.height as f32) as usize).min(self.height as usize - 1);
-        self.texel_pdf[j * self.width as usize + i]
+        let (i, j) = crate::latlong::latlong_uv_to_texel(uv, self.width, self.height);
+        self.texel_pdf[j as usize * self.width as usize + i as usize]
     }
 
     /// The `u` that [`EnvDistribution::sample_dir`] maps to `dir`.

@@ -133,10 +133,7 @@ impl EnvMap {
     /// The texel containing `dir` (its nearest texel centre in u and v).
     #[must_use]
     pub fn texel_of_dir(&self, dir: Vec3) -> (u32, u32) {
-        let uv = latlong_dir_to_uv(dir);
-        let i = ((uv.x * self.width as f32) as u32).min(self.width - 1);
-        let j = ((uv.y * self.height as f32) as u32).min(self.height - 1);
-        (i, j)
+        crate::latlong::latlong_uv_to_texel(latlong_dir_to_uv(dir), self.width, self.height)
     }
 
     /// Radiance of the texel containing `dir`.

@@ -38,6 +38,14 @@ pub fn latlong_dir_to_uv(dir: Vec3) -> Vec2 {
     Vec2::new(u, (theta / PI).clamp(0.0, 1.0))
 }
 
+/// The texel (i, j) of a `width` x `height` lat-long map containing `uv` (u = 1 or v = 1 fall in
+/// the last column or row).
+#[inline]
+#[must_use]
+pub fn latlong_uv_to_texel(uv: Vec2, width: u32, height: u32) -> (u32, u32) {
+    (((uv.x * width as f32) as u32).min(width - 1), ((uv.y * height as f32) as u32).min(height - 1))
+}
+
 /// Solid angle per unit area of (u, v): d omega = 2 pi^2 sin(pi v) du dv.
 #[inline]
 #[must_use]

@@ -103,14 +103,7 @@ fn shading_matches_ref_tracer_lights_without_shadows() {
         &bvh,
         Some(&env),
         &Integrator::Lights(set),
-        &RenderSettings {
-            spp: 16,
-            seed: 7,
-            time_budget: None,
-            aovs: true,
-            pixel_positions: None,
-            ..RenderSettings::default()
-        },
+        &RenderSettings { spp: 16, seed: 7, ..RenderSettings::default() },
         &|_, _| {},
     );
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);

@@ -79,12 +79,7 @@ impl<E: LightExtractor> AboveHorizon<E> {
     /// Re-spends the budget the inner method lost on the empty half: the inner budget goes up
     /// by the shortfall, and back down by one after an overshoot past K (the count is not
     /// monotonic in the budget), keeping the result with the most lights not above K.
-    fn fill(
-        &self,
-        upper: &EnvMap,
-        first: Decomposition,
-        k: usize,
-    ) -> Result<(Decomposition, Option<usize>), ExtractError> {
+    fn fill(&self, upper: &EnvMap, first: Decomposition, k: usize) -> Result<(Decomposition, usize), ExtractError> {
         let (mut last_budget, mut last_count) = (k, first.lights.len());
         let (mut best, mut best_budget) = (first, k);
         let mut tried = vec![k];
@@ -104,7 +99,7 @@ impl<E: LightExtractor> AboveHorizon<E> {
                 (best, best_budget) = (d, budget);
             }
         }
-        Ok((best, Some(best_budget)))
+        Ok((best, best_budget))
     }
 }
 
@@ -117,7 +112,8 @@ impl<E: LightExtractor> LightExtractor for AboveHorizon<E> {
         let mut d = self.inner.extract(&upper)?;
         let mut inner_budget = self.inner.budget();
         if let (true, Some(k)) = (self.fill_budget, inner_budget) {
-            (d, inner_budget) = self.fill(&upper, d, k)?;
+            let (filled, budget) = self.fill(&upper, d, k)?;
+            (d, inner_budget) = (filled, Some(budget));
         }
         if self.narrow_at_horizon {
             for l in &mut d.lights {

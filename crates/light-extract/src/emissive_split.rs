@@ -117,8 +117,8 @@ impl Cluster {
             .try_normalize()
             .or_else(|| self.members.iter().map(|m| m.0).sum::<DVec3>().try_normalize())?;
         let extent = self.members.iter().map(|(d, ..)| c.dot(*d).clamp(-1.0, 1.0).acos()).fold(0.0, f64::max);
-        let total: f64 = self.members.iter().map(|m| m.1.max(0.0)).sum();
-        let solid_angle = if moment_cone && total > 0.0 {
+        let total: f64 = if moment_cone { self.members.iter().map(|m| m.1.max(0.0)).sum() } else { 0.0 };
+        let solid_angle = if total > 0.0 {
             let four_pi = 4.0 * std::f64::consts::PI;
             let spread: f64 = self
                 .members

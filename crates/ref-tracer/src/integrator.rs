@@ -4,7 +4,8 @@
 //!   sample and one BRDF sample with the power heuristic; the truth approximations are measured
 //!   against. `Strategy` isolates either technique for tests.
 //! - `Lights`: direct illumination from distant cone lights with ray-traced visibility (cone
-//!   sampling, combined by MIS with a BRDF sample on glossy surfaces), plus an SH9 ambient term (unshadowed, or shadowed by cosine-sampled visibility).
+//!   sampling, combined by MIS with a BRDF sample on glossy surfaces), plus an SH9 ambient term
+//!   (unshadowed, or shadowed by cosine-sampled visibility).
 //! - `Path`: multi-bounce path tracing with the same MIS next-event estimation at every vertex.
 //!
 //! Surfaces do not emit; the map is the only light of `EnvDirect` and `Path`.

@@ -18,7 +18,7 @@
 //! let map = envmap_sphere::default_map().resize(64, 32);
 //! let env = EnvLight::new(&map);
 //! let bvh = SceneBvh::new(&scene);
-//! let settings = RenderSettings { spp: 2, seed: 1, time_budget: None, aovs: true, pixel_positions: None, ..RenderSettings::default() };
+//! let settings = RenderSettings { spp: 2, seed: 1, ..RenderSettings::default() };
 //! let img = render(&scene, &bvh, Some(&env), &Integrator::EnvDirect(Strategy::Mis), &settings, &|_, _| {});
 //! assert_eq!((img.width, img.height, img.spp), (32, 24, 2));
 //! assert!(img.color.iter().all(|c| c.is_finite()));

@@ -16,19 +16,7 @@ fn small(name: &str, w: u32, h: u32) -> Scene {
 }
 
 fn run(scene: &Scene, map: Option<&EnvMap>, integrator: &Integrator, spp: u32, seed: u64) -> Render {
-    run_with(
-        scene,
-        map,
-        integrator,
-        &RenderSettings {
-            spp,
-            seed,
-            time_budget: None,
-            aovs: true,
-            pixel_positions: None,
-            ..RenderSettings::default()
-        },
-    )
+    run_with(scene, map, integrator, &RenderSettings { spp, seed, ..RenderSettings::default() })
 }
 
 fn run_with(scene: &Scene, map: Option<&EnvMap>, integrator: &Integrator, settings: &RenderSettings) -> Render {
@@ -239,14 +227,8 @@ fn shared_pixel_positions_leave_no_antialiasing_noise() {
     let sh = Sh9::project(&envmap_sphere::default_map());
     let set = || LightSet { lights: &[], interleaved: &[], ambient: Some(sh), shadow_ambient: false, background: None };
     let scene = small("spheres_box", 40, 30);
-    let settings = |seed, pixel_positions| RenderSettings {
-        spp: 4,
-        seed,
-        time_budget: None,
-        aovs: false,
-        pixel_positions,
-        ..RenderSettings::default()
-    };
+    let settings =
+        |seed, pixel_positions| RenderSettings { spp: 4, seed, aovs: false, pixel_positions, ..Default::default() };
     let a = run_with(&scene, None, &Integrator::Lights(set()), &settings(1, Some(4)));
     let b = run_with(&scene, None, &Integrator::Lights(set()), &settings(2, Some(4)));
     assert_eq!(a.color, b.color, "the same positions for any seed");

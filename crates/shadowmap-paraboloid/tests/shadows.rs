@@ -24,15 +24,12 @@ fn room(w: u32, h: u32) -> Scene {
     s
 }
 
-/// G-buffer points (position, geometric normal) of the scene's view; background as NaN.
-fn receivers(gpu: &Gpu, gb: &GBuffer) -> Vec<(Vec3, Vec3)> {
-    gb.read_points(gpu).unwrap()
-}
-
 struct Setup {
     gpu: Gpu,
     scene: Scene,
     gb: GBuffer,
+    /// the G-buffer's points (position, geometric normal), read back once; background as NaN
+    points: Vec<(Vec3, Vec3)>,
     mapper: ShadowMapper,
 }
 
@@ -41,8 +38,9 @@ impl Setup {
         let gpu = gpu();
         let geometry = SceneGeometry::upload(&gpu, &scene).unwrap();
         let gb = GBufferPass::new(&gpu).render(&gpu, &geometry, &scene.camera).unwrap();
+        let points = gb.read_points(&gpu).unwrap();
         let mapper = ShadowMapper::new(&gpu);
-        Self { gpu, scene, gb, mapper }
+        Self { gpu, scene, gb, points, mapper }
     }
 
     fn map(&self, triangles: &[[Vec3; 3]], light: &ShadowLight, t: Technique, s: &ShadowSettings) -> ShadowMap {
@@ -59,7 +57,7 @@ impl Setup {
     }
 
     fn truth(&self, light: VisibilityLight) -> Vec<Option<bool>> {
-        light_visibility(&SceneBvh::new(&self.scene), &receivers(&self.gpu, &self.gb), light)
+        light_visibility(&SceneBvh::new(&self.scene), &self.points, light)
     }
 }
 
@@ -93,7 +91,8 @@ fn gpu_visibility_matches_the_cpu_shadow_test() {
     let frame = map.frame.unwrap();
     let cpu_maps = [Hemisphere::Front, Hemisphere::Back].map(|h| CpuParaboloidMap::rasterize(&frame, h, 512, &tris));
     let mask = s.mask(&map);
-    let truth: Vec<Option<bool>> = receivers(&s.gpu, &s.gb)
+    let truth: Vec<Option<bool>> = s
+        .points
         .iter()
         .map(|&(p, n)| if p.is_finite() { lit(&cpu_maps, p, n, settings.bias_texels) } else { None })
         .collect();
@@ -126,10 +125,10 @@ fn a_hemispherical_light_gets_one_map_and_lights_only_its_hemisphere() {
     let map = s.map(&tris, &light, Technique::DualParaboloid, &ShadowSettings::default());
     assert_eq!(map.views.len(), 1);
     let mask = s.mask(&map);
-    let points = receivers(&s.gpu, &s.gb);
+    let points = &s.points;
     let truth = s.truth(VisibilityLight::Point(position));
     let (mut above, mut wrong_below) = (0, 0);
-    for ((m, (p, _)), t) in mask.iter().zip(&points).zip(&truth) {
+    for ((m, (p, _)), t) in mask.iter().zip(points).zip(&truth) {
         if p.is_finite() && p.y > position.y + 0.05 {
             above += 1;
             assert_eq!(*m, 0.0, "{p} is behind the light's hemisphere");
@@ -224,10 +223,10 @@ fn a_light_inside_an_occluder_shadows_everything_outside() {
     for technique in [Technique::DualParaboloid, Technique::Cube] {
         let map = s.map(&tris, &ShadowLight::omni(position), technique, &ShadowSettings::fast());
         let mask = s.mask(&map);
-        let points = receivers(&s.gpu, &s.gb);
+        let points = &s.points;
         let outside: Vec<f32> = mask
             .iter()
-            .zip(&points)
+            .zip(points)
             .filter(|(_, (p, _))| p.is_finite() && (*p - position).abs().max_element() > 0.25)
             .map(|(m, _)| *m)
             .collect();
