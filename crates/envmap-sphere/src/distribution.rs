@@ -302,7 +302,7 @@ pub(crate) fn texel_point(
     // uv of the same point, kept inside the sampled texel despite rounding
     let inside =
         |x: f32, k: usize, n: f32| x.clamp(k as f32 / n, ((k + 1) as f32 / n).next_down()).min(ONE_MINUS_EPSILON);
-    let theta = sin_theta.atan2(cos_theta);
+    let theta = crate::latlong::atan2(sin_theta, cos_theta);
     let uv = Vec2::new(inside((i as f32 + s) / w, i, w), inside(theta / std::f32::consts::PI, j, h));
     // The pdf of the texel the sample was drawn in. `dir_pdf(dir)` agrees except within
     // f32 rounding of a texel edge, where the direction may round into the neighbour.

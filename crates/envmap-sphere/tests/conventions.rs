@@ -2,7 +2,7 @@
 
 mod common;
 
-use envmap_sphere::latlong::{latlong_dir_to_uv, latlong_texel_solid_angle, latlong_uv_to_dir};
+use envmap_sphere::latlong::{atan2, latlong_dir_to_uv, latlong_texel_solid_angle, latlong_uv_to_dir};
 use envmap_sphere::{EnvMap, Sh9};
 use glam::{Vec2, Vec3};
 use std::f64::consts::PI;
@@ -65,6 +65,37 @@ fn dir_uv_dir_round_trips_for_random_directions() {
         let back = latlong_uv_to_dir(uv);
         assert!((back - d).length() < 2e-6, "{d} -> {uv} -> {back}");
     }
+}
+
+#[test]
+fn fast_atan2_matches_libm_everywhere() {
+    use rand::Rng;
+    let mut rng = common::rng(11);
+    // error in units of the f32 spacing at the exact result (libm's own is up to about 0.5)
+    let mut worst = 0.0f64;
+    for k in 0..400_000 {
+        // every octant and ratios from 1e-30 to 1e30
+        let scale = |r: &mut rand_pcg::Pcg64Mcg| 10f32.powf(r.random_range(-30.0..30.0));
+        let (y, x) = if k % 2 == 0 {
+            (rng.random_range(-1.0f32..1.0), rng.random_range(-1.0f32..1.0))
+        } else {
+            (rng.random_range(-1.0f32..1.0) * scale(&mut rng), rng.random_range(-1.0f32..1.0) * scale(&mut rng))
+        };
+        let exact = f64::from(y).atan2(f64::from(x));
+        let ulp = f64::from((exact as f32).abs().next_up() - (exact as f32).abs());
+        worst = worst.max((f64::from(atan2(y, x)) - exact).abs() / ulp);
+    }
+    assert!(worst < 3.0, "largest error {worst} ulp");
+    // Zeros, infinities and NaN keep libm's exact answers (signed zeros decide u at the poles).
+    let special = [0.0f32, -0.0, f32::INFINITY, f32::NEG_INFINITY];
+    let any = [0.0f32, -0.0, 1.0, -1.0, f32::MIN_POSITIVE, f32::MAX, f32::INFINITY, f32::NEG_INFINITY];
+    for a in special {
+        for b in any {
+            assert_eq!(atan2(a, b).to_bits(), a.atan2(b).to_bits(), "atan2({a}, {b})");
+            assert_eq!(atan2(b, a).to_bits(), b.atan2(a).to_bits(), "atan2({b}, {a})");
+        }
+    }
+    assert!(atan2(f32::NAN, 1.0).is_nan() && atan2(1.0, f32::NAN).is_nan());
 }
 
 #[test]

@@ -171,30 +171,46 @@ fn env_direct(
     let mut l = Vec3::ZERO;
     let u_env = s.next_2d();
     let (u_brdf, u_lobe) = (s.next_2d(), s.next_1d());
-    if strategy != Strategy::BrdfOnly {
-        let ls = env.dist.sample_dir(u_env);
-        let (fc, wi) = sh.f_cos(ls.dir);
-        if ls.pdf > 0.0 && fc != Vec3::ZERO && !bvh.occluded(sh.origin(), ls.dir, f32::INFINITY) {
-            let w =
-                if strategy == Strategy::Mis { power_heuristic(ls.pdf, sh.material.brdf_pdf(sh.wo, wi)) } else { 1.0 };
-            l += fc * env.map.lookup_uv(ls.uv) * (w / ls.pdf);
-        }
-    }
-    let mut next = None;
-    if let Some((wi, pdf)) = sh.material.sample_brdf(sh.wo, u_brdf, u_lobe) {
+    // Both samples read the map and the pdf table before either ray is traced, the BRDF
+    // sample's pdf look-up first: the cache misses of those scattered reads then overlap,
+    // instead of each waiting behind a traversal.
+    let brdf_sample = sh.material.sample_brdf(sh.wo, u_brdf, u_lobe).and_then(|(wi, pdf)| {
         let wi_world = sh.frame.to_world(wi);
         let (fc, _) = sh.f_cos(wi_world);
-        if fc != Vec3::ZERO {
-            let hit = if trace_brdf_ray { bvh.intersect(sh.origin(), wi_world, f32::INFINITY) } else { None };
-            let escaped =
-                if trace_brdf_ray { hit.is_none() } else { !bvh.occluded(sh.origin(), wi_world, f32::INFINITY) };
-            if strategy != Strategy::EnvOnly && escaped {
+        (fc != Vec3::ZERO).then(|| {
+            let looked_up = (strategy != Strategy::EnvOnly).then(|| {
                 let uv = envmap_sphere::latlong::latlong_dir_to_uv(wi_world);
-                let w = if strategy == Strategy::Mis { power_heuristic(pdf, env.dist.uv_pdf(uv)) } else { 1.0 };
-                l += fc * env.map.lookup_uv(uv) * (w / pdf);
-            }
-            next = Some(Continuation { dir: wi_world, weight: fc / pdf, hit });
+                (uv, if strategy == Strategy::Mis { env.dist.uv_pdf(uv) } else { 0.0 })
+            });
+            (wi_world, fc, pdf, looked_up)
+        })
+    });
+    let env_sample = if strategy == Strategy::BrdfOnly { None } else { Some(env.dist.sample_dir(u_env)) };
+    let brdf_sample = brdf_sample.map(|(wi_world, fc, pdf, looked_up)| {
+        let term = looked_up.map(|(uv, env_pdf)| fc * env.map.lookup_uv(uv) * (power_heuristic(pdf, env_pdf) / pdf));
+        (wi_world, fc / pdf, term)
+    });
+    let env_term = env_sample.and_then(|ls| {
+        let (fc, wi) = sh.f_cos(ls.dir);
+        (ls.pdf > 0.0 && fc != Vec3::ZERO).then(|| {
+            let w =
+                if strategy == Strategy::Mis { power_heuristic(ls.pdf, sh.material.brdf_pdf(sh.wo, wi)) } else { 1.0 };
+            (ls.dir, fc * env.map.lookup_uv(ls.uv) * (w / ls.pdf))
+        })
+    });
+    if let Some((dir, term)) = env_term
+        && !bvh.occluded(sh.origin(), dir, f32::INFINITY)
+    {
+        l += term;
+    }
+    let mut next = None;
+    if let Some((wi_world, weight, term)) = brdf_sample {
+        let hit = if trace_brdf_ray { bvh.intersect(sh.origin(), wi_world, f32::INFINITY) } else { None };
+        let escaped = if trace_brdf_ray { hit.is_none() } else { !bvh.occluded(sh.origin(), wi_world, f32::INFINITY) };
+        if escaped && let Some(term) = term {
+            l += term;
         }
+        next = Some(Continuation { dir: wi_world, weight, hit });
     }
     (l, next)
 }
