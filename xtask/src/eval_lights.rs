@@ -263,7 +263,7 @@ fn write_tables(rows: &[Row], args: &EvalArgs) -> Result<(), String> {
     let md_path = args.out.join("eval-lights.md");
     std::fs::write(&csv_path, csv).map_err(|e| format!("{}: {e}", csv_path.display()))?;
     std::fs::write(&md_path, &md).map_err(|e| format!("{}: {e}", md_path.display()))?;
-    print!("{md}");
+    outln!("{md}");
     outln!("\nwrote {} and {}", csv_path.display(), md_path.display());
     Ok(())
 }

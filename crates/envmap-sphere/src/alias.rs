@@ -6,10 +6,10 @@
 //! phi and cos theta); only the mapping from random numbers to texels differs. That mapping is
 //! not monotonic, so it has no inverse: [`EnvDistribution`] keeps `invert_dir_sample`.
 //!
-//! Each column bin carries the pdf of both its outcomes, so a draw reads the small row table
-//! (cache resident) and one 16-byte bin. The pdf of a direction (the MIS weight of every BRDF
-//! sample) reads a separate array of texel pdfs, a quarter of the bins' size: it stays in cache
-//! far more often.
+//! Texel pdfs sit in their own array, a quarter of the bins' size, so the pdf of a direction
+//! (the MIS weight of every BRDF sample) stays in cache far more often. A column bin carries
+//! the pdf of its alias, so a draw reads the small row table (cache resident), one 16-byte bin
+//! and, at an address known before the bin arrives, its own texel's pdf.
 
 use crate::distribution::{DirSample, EnvDistribution, ONE_MINUS_EPSILON, texel_point};
 use crate::latlong::latlong_dir_to_uv;
@@ -122,12 +122,12 @@ impl AliasTable {
     }
 }
 
-/// A column bin of [`EnvAliasDistribution`]: the alias choice plus the pdf of both outcomes.
+/// A column bin of [`EnvAliasDistribution`]: the alias choice plus the alias's pdf (aligned so
+/// a bin never straddles two cache lines).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(16))]
 struct ColumnBin {
     bin: AliasBin,
-    pdf: f32,
     alias_pdf: f32,
 }
 
@@ -147,7 +147,7 @@ pub struct EnvAliasDistribution {
     height: u32,
     rows: AliasTable,
     cols: Vec<ColumnBin>,
-    /// texel pdfs, row-major: the same values as the bins' `pdf`
+    /// texel pdfs per steradian, row-major
     pdfs: Vec<f32>,
     row_cos: Vec<(f64, f64)>,
 }
@@ -162,14 +162,13 @@ impl EnvAliasDistribution {
         let mut weights = vec![0.0; w as usize];
         for j in 0..h as usize {
             weights.iter_mut().enumerate().for_each(|(i, x)| *x = dist.column_probability(j, i));
-            let pdf = |i: u32| dist.texel_pdf(i as usize, j);
-            cols.extend(build(&weights).into_iter().enumerate().map(|(i, bin)| ColumnBin {
-                bin,
-                pdf: pdf(i as u32),
-                alias_pdf: pdf(bin.alias),
-            }));
+            cols.extend(
+                build(&weights)
+                    .into_iter()
+                    .map(|bin| ColumnBin { bin, alias_pdf: dist.texel_pdf(bin.alias as usize, j) }),
+            );
         }
-        let pdfs = cols.iter().map(|c| c.pdf).collect();
+        let pdfs = (0..h as usize).flat_map(|j| (0..w as usize).map(move |i| dist.texel_pdf(i, j))).collect();
         Self { width: w, height: h, rows, cols, pdfs, row_cos: dist.row_cos().to_vec() }
     }
 
@@ -182,7 +181,7 @@ impl EnvAliasDistribution {
         let (w, h) = (self.width as usize, self.height as usize);
         let row = &self.cols[j * w..(j + 1) * w];
         let (k, i, s, aliased) = draw(w, u.x, |k| row[k].bin);
-        let pdf = if aliased { row[k].alias_pdf } else { row[k].pdf };
+        let pdf = if aliased { row[k].alias_pdf } else { self.pdfs[j * w + k] };
         texel_point([w, h], &self.row_cos, [i, j], [s, t], pdf)
     }
 

@@ -215,8 +215,7 @@ impl EnvDistribution {
     pub fn sample_dir(&self, u: Vec2) -> DirSample {
         let (j, t) = self.rows.sample(u.y);
         let (i, s) = self.cols[j].sample(u.x);
-        let w = self.width as usize;
-        texel_point([w, self.height as usize], &self.row_cos, [i, j], [s, t], self.texel_pdf[j * w + i])
+        texel_point([self.width as usize, self.height as usize], &self.row_cos, [i, j], [s, t], self.texel_pdf(i, j))
     }
 
     /// Size of the map (width, height).
@@ -259,7 +258,7 @@ impl EnvDistribution {
     #[must_use]
     pub fn uv_pdf(&self, uv: Vec2) -> f32 {
         let (i, j) = crate::latlong::latlong_uv_to_texel(uv, self.width, self.height);
-        self.texel_pdf[j as usize * self.width as usize + i as usize]
+        self.texel_pdf(i as usize, j as usize)
     }
 
     /// The `u` that [`EnvDistribution::sample_dir`] maps to `dir`.

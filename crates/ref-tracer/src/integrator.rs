@@ -180,14 +180,17 @@ fn env_direct(
         (fc != Vec3::ZERO).then(|| {
             let looked_up = (strategy != Strategy::EnvOnly).then(|| {
                 let uv = envmap_sphere::latlong::latlong_dir_to_uv(wi_world);
-                (uv, if strategy == Strategy::Mis { env.dist.uv_pdf(uv) } else { 0.0 })
+                (uv, (strategy == Strategy::Mis).then(|| env.dist.uv_pdf(uv)))
             });
             (wi_world, fc, pdf, looked_up)
         })
     });
     let env_sample = if strategy == Strategy::BrdfOnly { None } else { Some(env.dist.sample_dir(u_env)) };
     let brdf_sample = brdf_sample.map(|(wi_world, fc, pdf, looked_up)| {
-        let term = looked_up.map(|(uv, env_pdf)| fc * env.map.lookup_uv(uv) * (power_heuristic(pdf, env_pdf) / pdf));
+        let term = looked_up.map(|(uv, env_pdf)| {
+            let w = env_pdf.map_or(1.0, |env_pdf| power_heuristic(pdf, env_pdf));
+            fc * env.map.lookup_uv(uv) * (w / pdf)
+        });
         (wi_world, fc / pdf, term)
     });
     let env_term = env_sample.and_then(|ls| {
