@@ -15,6 +15,8 @@ pub struct EvalArgs {
     pub maps: PathBuf,
     pub scenes: Vec<String>,
     pub lights: usize,
+    /// Labels of the methods to run (median cut always runs); empty: all.
+    pub methods: Vec<String>,
     pub spp: u32,
     pub lights_spp: u32,
     pub size: (u32, u32),
@@ -34,10 +36,23 @@ struct Row {
     extract_ms: f64,
 }
 
+/// A row of the table: its label and its extractor.
+type Method = (String, Box<dyn LightExtractor>);
+
+/// The methods labelled in `only` and median cut (all when `only` is empty), in table order.
+fn chosen_methods(k: usize, only: &[String]) -> Result<Vec<Method>, String> {
+    let all = methods(k);
+    if let Some(unknown) = only.iter().find(|m| !all.iter().any(|(label, _)| label == *m)) {
+        let labels: Vec<&str> = all.iter().map(|(label, _)| label.as_str()).collect();
+        return Err(format!("unknown method {unknown:?}; available: {}", labels.join(", ")));
+    }
+    Ok(all.into_iter().filter(|(label, _)| only.is_empty() || label == "median-cut" || only.contains(label)).collect())
+}
+
 /// (label, extractor): Table 1's methods, then Table 2's ablation of EmissiveSplit, then our
 /// above-horizon options (not the papers': only the hemisphere above the ground reaches the
 /// receivers).
-fn methods(k: usize) -> Vec<(String, Box<dyn LightExtractor>)> {
+fn methods(k: usize) -> Vec<Method> {
     let es = EmissiveSplit { lights: k, ..EmissiveSplit::default() };
     let ablations: [(&str, Box<dyn LightExtractor>); 3] = [
         ("emissive-split/no-masking", Box::new(EmissiveSplit { masking: false, ..es })),
@@ -73,7 +88,7 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
     if maps.is_empty() {
         return Err(format!("{}: no .exr or .hdr maps", args.maps.display()));
     }
-    let n_methods = methods(args.lights).len();
+    let n_methods = chosen_methods(args.lights, &args.methods)?.len();
     let bar = indicatif::ProgressBar::new((maps.len() * args.scenes.len() * (2 + n_methods)) as u64);
     bar.set_style(
         indicatif::ProgressStyle::with_template(
@@ -97,7 +112,7 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
         let map = load_map(Some(map_path))?;
         let map_name = map_path.file_name().map_or_else(String::new, |n| n.to_string_lossy().to_string());
         let env = EnvLight::new(&map);
-        let decompositions: Vec<_> = methods(args.lights)
+        let decompositions: Vec<_> = chosen_methods(args.lights, &args.methods)?
             .iter()
             .map(|(label, m)| {
                 let mut d = m.extract(&map).map_err(|e| format!("{}: {e}", map_path.display()))?;

@@ -88,6 +88,10 @@ enum Command {
         /// Lights per method K.
         #[arg(long, default_value_t = 32)]
         lights: usize,
+        /// Comma-separated method labels of the table to run (median cut, the reference of the
+        /// ratios, always runs); every method when absent.
+        #[arg(long, value_delimiter = ',')]
+        methods: Vec<String>,
         /// Samples per pixel of the env-direct truth (its noise floor is reported).
         #[arg(long, default_value_t = 1024)]
         spp: u32,
@@ -132,11 +136,12 @@ fn main() -> ExitCode {
         Command::Scene { name, obj } => scene::run(&name, &obj),
         Command::Render(args) => render::run(&args),
         Command::Compare { reference, test } => render::compare(&reference, &test),
-        Command::EvalLights { maps, scenes, lights, spp, lights_spp, size, out } => {
+        Command::EvalLights { maps, scenes, lights, methods, spp, lights_spp, size, out } => {
             eval_lights::run(&eval_lights::EvalArgs {
                 maps: maps.unwrap_or_else(eval_lights::default_maps_dir),
                 scenes,
                 lights,
+                methods,
                 spp,
                 lights_spp,
                 size,

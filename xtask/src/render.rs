@@ -57,6 +57,10 @@ pub struct RenderArgs {
     /// Sample points: sobol (Owen-scrambled Sobol, stratified) or independent (plain Monte Carlo).
     #[arg(long, default_value = "sobol")]
     pub sampler: String,
+    /// Map samples of env-direct and path: compensated (MIS compensation: only what stands out
+    /// of the map's mean, the rest left to the BRDF sample) or complete (the whole map).
+    #[arg(long, default_value = "compensated")]
+    pub env_sampling: String,
 }
 
 /// The map from `--envmap`, or the embedded default.
@@ -161,7 +165,13 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         }
         other => return Err(format!("unknown integrator {other:?}: env-direct, lights or path")),
     };
-    let env = EnvLight::new(&map);
+    // the lights integrator samples its lights, not the map
+    let env = match (&integrator, args.env_sampling.as_str()) {
+        (Integrator::Lights(_), _) => None,
+        (_, "compensated") => Some(EnvLight::new(&map)),
+        (_, "complete") => Some(EnvLight::complete(&map)),
+        (_, other) => return Err(format!("unknown env sampling {other:?}; available: compensated, complete")),
+    };
     let bvh = SceneBvh::new(&scene);
     let bar = indicatif::ProgressBar::new(u64::from(args.spp));
     bar.set_style(
@@ -181,7 +191,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             other => return Err(format!("unknown sampler {other:?}; available: sobol, independent")),
         },
     };
-    let img = ref_tracer::render(&scene, &bvh, Some(&env), &integrator, &settings, &|done, _| {
+    let img = ref_tracer::render(&scene, &bvh, env.as_ref(), &integrator, &settings, &|done, _| {
         bar.set_position(u64::from(done))
     });
     bar.finish_and_clear();

@@ -122,8 +122,13 @@ fn render_writes_images_and_compare_reports_rmse_and_flip() {
     for f in ["a.exr", "a.png", "a.albedo.exr", "a.normal.exr", "a.depth.exr", "a.object.exr"] {
         assert!(dir.join(f).exists(), "{f} missing");
     }
-    let out = xtask(&[&base[..], &["--seed", "2", "--out", b.to_str().unwrap_or_default()]].concat());
-    assert!(out.status.success());
+    let out = xtask(
+        &[&base[..], &["--seed", "2", "--env-sampling", "complete", "--out", b.to_str().unwrap_or_default()]].concat(),
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = xtask(&[&base[..], &["--env-sampling", "some", "--out", b.to_str().unwrap_or_default()]].concat());
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).trim().lines().count() == 1);
     let out = xtask(&["compare", a.to_str().unwrap_or_default(), b.to_str().unwrap_or_default()]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let text = String::from_utf8_lossy(&out.stdout);
@@ -242,23 +247,12 @@ fn eval_lights_writes_both_tables_with_a_noise_floor() {
     std::fs::create_dir_all(&maps).expect("scratch dir");
     std::fs::copy(shared("venice_sunset_1k.hdr"), maps.join("venice.hdr")).expect("copy map");
     let out_dir = dir.join("out");
-    let out = xtask(&[
-        "eval-lights",
-        "--maps",
-        maps.to_str().unwrap_or_default(),
-        "--scenes",
-        "spheres_box",
-        "--lights",
-        "4",
-        "--spp",
-        "4",
-        "--lights-spp",
-        "2",
-        "--size",
-        "16x12",
-        "--out",
-        out_dir.to_str().unwrap_or_default(),
-    ]);
+    let eval = |extra: &[&str]| {
+        let base =
+            ["eval-lights", "--maps", maps.to_str().unwrap_or_default(), "--scenes", "spheres_box", "--lights", "4"];
+        xtask(&[&base[..], extra, &["--out", out_dir.to_str().unwrap_or_default()]].concat())
+    };
+    let out = eval(&["--spp", "4", "--lights-spp", "2", "--size", "16x12"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let csv = std::fs::read_to_string(out_dir.join("eval-lights.csv")).expect("csv");
     let lines: Vec<&str> = csv.lines().collect();
@@ -295,4 +289,17 @@ fn eval_lights_writes_both_tables_with_a_noise_floor() {
     }
     let md = std::fs::read_to_string(out_dir.join("eval-lights.md")).expect("md");
     assert!(md.contains("| median-cut |") && md.contains("RMSE / median cut"), "{md}");
+    // --methods: those rows, the floor and median cut; an unknown label: exit 1, one line
+    let run = |methods: &str| eval(&["--spp", "2", "--lights-spp", "1", "--size", "8x6", "--methods", methods]);
+    let out = run("importance,emissive-split/neither");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let csv = std::fs::read_to_string(out_dir.join("eval-lights.csv")).expect("csv");
+    let mut methods: Vec<&str> =
+        csv.lines().skip(1).filter_map(|l| l.splitn(3, ',').nth(2)?.rsplitn(6, ',').last()).collect();
+    methods.sort_unstable();
+    assert_eq!(methods, ["\"(reference, other seed)\"", "emissive-split/neither", "importance", "median-cut"], "{csv}");
+    let out = run("median-cut,no-such-method");
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.trim().lines().count() == 1 && err.contains("no-such-method"), "{err}");
 }

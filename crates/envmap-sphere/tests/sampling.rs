@@ -31,7 +31,11 @@ fn test_map() -> EnvMap {
 #[test]
 fn pdf_integrates_to_one() {
     for map in [test_map(), envmap_sphere::default_map()] {
-        for dist in [EnvDistribution::new(&map), EnvDistribution::for_bilinear(&map)] {
+        for dist in [
+            EnvDistribution::new(&map),
+            EnvDistribution::for_bilinear(&map),
+            EnvDistribution::for_bilinear_compensated(&map),
+        ] {
             // Quadrature on a grid 3x finer than the texels, independent of the texel layout.
             let (w, h) = (map.width() * 3, map.height() * 3);
             let fine = EnvMap::constant(w, h, Vec3::ZERO);
@@ -291,23 +295,27 @@ fn summed_area_table_matches_brute_force_sums() {
     assert!((total - luminance(Vec3::new(rgb[0] as f32, rgb[1] as f32, rgb[2] as f32)) as f64).abs() < 1e-4 * total);
 }
 
+/// Independently of the distributions: the largest luminance in texel (i, j)'s 3 x 3
+/// neighbourhood, wrapping in u and clamped in v.
+fn neighbourhood_max(map: &EnvMap, i: i64, j: i64) -> f64 {
+    let (w, h) = (i64::from(map.width()), i64::from(map.height()));
+    let mut m = 0.0f64;
+    for dj in -1..=1 {
+        for di in -1..=1 {
+            let p = map.pixel((i + di).rem_euclid(w) as u32, (j + dj).clamp(0, h - 1) as u32);
+            m = m.max(f64::from(luminance(p)));
+        }
+    }
+    m
+}
+
 #[test]
 fn bilinear_distribution_bounds_radiance_over_pdf() {
     let map = envmap_sphere::default_map();
     let plain = EnvDistribution::new(&map);
     let safe = EnvDistribution::for_bilinear(&map);
-    // Independently: weight = largest luminance in the 3 x 3 neighbourhood, normalized.
     let (w, h) = (map.width() as i64, map.height() as i64);
-    let weight = |i: i64, j: i64| {
-        let mut m = 0.0f64;
-        for dj in -1..=1 {
-            for di in -1..=1 {
-                let p = map.pixel((i + di).rem_euclid(w) as u32, (j + dj).clamp(0, h - 1) as u32);
-                m = m.max(f64::from(luminance(p)));
-            }
-        }
-        m
-    };
+    let weight = |i: i64, j: i64| neighbourhood_max(&map, i, j);
     let total: f64 = (0..h).map(|j| (0..w).map(|i| weight(i, j)).sum::<f64>() * map.texel_solid_angle(j as u32)).sum();
     let mut rng = common::rng(12);
     let (mut worst_plain, mut worst_safe) = (0.0f64, 0.0f64);
@@ -326,6 +334,48 @@ fn bilinear_distribution_bounds_radiance_over_pdf() {
     // bilinear Y / pdf never exceeds the normalization of the 3 x 3 weights
     assert!(worst_safe <= total * (1.0 + 1e-4), "{worst_safe} > {total}");
     assert!(worst_plain > 10.0 * worst_safe, "the plain distribution has the spikes this one removes");
+}
+
+#[test]
+fn compensated_pdf_is_the_weight_above_its_mean() {
+    for map in [test_map(), envmap_sphere::default_map()] {
+        let dist = EnvDistribution::for_bilinear_compensated(&map);
+        let (w, h) = (i64::from(map.width()), i64::from(map.height()));
+        let sa = |j: i64| map.texel_solid_angle(j as u32);
+        let mean = (0..h).map(|j| (0..w).map(|i| neighbourhood_max(&map, i, j)).sum::<f64>() * sa(j)).sum::<f64>()
+            / (4.0 * PI);
+        let weight = |i: i64, j: i64| (neighbourhood_max(&map, i, j) - mean).max(0.0);
+        let total: f64 = (0..h).map(|j| (0..w).map(|i| weight(i, j)).sum::<f64>() * sa(j)).sum();
+        let mut zero = 0;
+        for j in 0..h {
+            for i in 0..w {
+                let want = (weight(i, j) / total) as f32;
+                let pdf = dist.texel_pdf(i as usize, j as usize);
+                assert!((pdf - want).abs() <= 1e-5 * want, "({i}, {j}): {pdf} vs {want}");
+                zero += usize::from(pdf == 0.0);
+            }
+        }
+        assert!(zero > 0, "texels below the mean get no map samples");
+        let alias = EnvAliasDistribution::new(&dist);
+        let mut rng = common::rng(17);
+        for _ in 0..100_000 {
+            let s = alias.sample_dir(Vec2::new(rng.random(), rng.random()));
+            assert!(s.pdf > 0.0 && s.pdf == dist.uv_pdf(s.uv), "sample in a zero-pdf texel at {}", s.uv);
+        }
+    }
+}
+
+#[test]
+fn compensating_a_constant_map_keeps_it_uniform() {
+    for map in [EnvMap::constant(64, 32, Vec3::splat(3.0)), EnvMap::constant(8, 4, Vec3::ZERO)] {
+        let dist = EnvDistribution::for_bilinear_compensated(&map);
+        let uniform = (1.0 / (4.0 * PI)) as f32;
+        for j in 0..map.height() as usize {
+            for i in 0..map.width() as usize {
+                assert!((dist.texel_pdf(i, j) - uniform).abs() < 1e-5 * uniform, "({i}, {j})");
+            }
+        }
+    }
 }
 
 #[test]

@@ -35,14 +35,32 @@ pub struct EnvLight<'a> {
     pub map: &'a EnvMap,
     /// Its importance sampling distribution, in alias form: O(1) draws.
     pub dist: EnvAliasDistribution,
+    /// Whether `dist` is MIS-compensated: incomplete, so valid only combined with BRDF samples
+    /// ([`Strategy::Mis`], path tracing), not for [`Strategy::EnvOnly`].
+    pub compensated: bool,
 }
 
 impl<'a> EnvLight<'a> {
-    /// Builds the sampling distribution of `map` ([`EnvDistribution::for_bilinear`]: the map is
-    /// evaluated bilinearly).
+    /// The light for MIS ([`Strategy::Mis`] and path tracing): map samples from
+    /// [`EnvDistribution::for_bilinear_compensated`], which leaves the map's smooth part to
+    /// the BRDF sample.
     #[must_use]
     pub fn new(map: &'a EnvMap) -> Self {
-        Self { map, dist: EnvAliasDistribution::new(&EnvDistribution::for_bilinear(map)) }
+        let dist = EnvAliasDistribution::new(&EnvDistribution::for_bilinear_compensated(map));
+        Self { map, dist, compensated: true }
+    }
+
+    /// The light with the complete distribution ([`EnvDistribution::for_bilinear`]: positive
+    /// pdf wherever the map is), which map-only sampling needs.
+    #[must_use]
+    pub fn complete(map: &'a EnvMap) -> Self {
+        Self { map, dist: EnvAliasDistribution::new(&EnvDistribution::for_bilinear(map)), compensated: false }
+    }
+
+    /// The light `strategy` needs: complete for [`Strategy::EnvOnly`], compensated otherwise.
+    #[must_use]
+    pub fn for_strategy(map: &'a EnvMap, strategy: Strategy) -> Self {
+        if strategy == Strategy::EnvOnly { Self::complete(map) } else { Self::new(map) }
     }
 }
 
@@ -133,6 +151,10 @@ impl Integrator<'_> {
         match self {
             Self::EnvDirect(strategy) => {
                 let env = env.expect("EnvDirect needs the map");
+                debug_assert!(
+                    !(env.compensated && *strategy == Strategy::EnvOnly),
+                    "map-only sampling needs the complete distribution (EnvLight::for_strategy)"
+                );
                 match bvh.intersect(origin, dir, f32::INFINITY) {
                     None => env.map.lookup(dir),
                     Some(sp) => env_direct(bvh, env, &Shading::new(bvh, &sp, dir), *strategy, false, s).0,

@@ -21,7 +21,10 @@ fn run(scene: &Scene, map: Option<&EnvMap>, integrator: &Integrator, spp: u32, s
 
 fn run_with(scene: &Scene, map: Option<&EnvMap>, integrator: &Integrator, settings: &RenderSettings) -> Render {
     let bvh = SceneBvh::new(scene);
-    let env = map.map(EnvLight::new);
+    let env = map.map(|m| match integrator {
+        Integrator::EnvDirect(strategy) => EnvLight::for_strategy(m, *strategy),
+        _ => EnvLight::new(m),
+    });
     render(scene, &bvh, env.as_ref(), integrator, settings, &|_, _| {})
 }
 
@@ -170,6 +173,30 @@ fn rmse_halves_for_every_four_times_the_samples() {
         assert!(pair[0] / pair[1] > 2.0 * 0.85, "RMSE {sobol:?}");
         assert!(s < i, "Sobol {sobol:?} vs independent {independent:?}");
     }
+}
+
+#[test]
+fn mis_compensation_lowers_the_error() {
+    let scene = small("spheres_box", 48, 36);
+    let map = envmap_sphere::default_map().resize(256, 128);
+    let bvh = SceneBvh::new(&scene);
+    let integrator = Integrator::EnvDirect(Strategy::Mis);
+    let draw = |env: &EnvLight, spp, seed| {
+        render(
+            &scene,
+            &bvh,
+            Some(env),
+            &integrator,
+            &RenderSettings { spp, seed, ..RenderSettings::default() },
+            &|_, _| {},
+        )
+        .color
+    };
+    let (compensated, complete) = (EnvLight::new(&map), EnvLight::complete(&map));
+    let reference = draw(&complete, 2048, 999);
+    let error = |env: &EnvLight| (1..=3).map(|seed| metrics::rmse(&reference, &draw(env, 16, seed))).sum::<f64>() / 3.0;
+    let (with, without) = (error(&compensated), error(&complete));
+    assert!(with < 0.9 * without, "RMSE at 16 spp: {with} compensated vs {without} complete");
 }
 
 #[test]
