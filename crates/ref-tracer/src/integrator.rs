@@ -151,10 +151,6 @@ impl Integrator<'_> {
         match self {
             Self::EnvDirect(strategy) => {
                 let env = env.expect("EnvDirect needs the map");
-                debug_assert!(
-                    !(env.compensated && *strategy == Strategy::EnvOnly),
-                    "map-only sampling needs the complete distribution (EnvLight::for_strategy)"
-                );
                 match bvh.intersect(origin, dir, f32::INFINITY) {
                     None => env.map.lookup(dir),
                     Some(sp) => env_direct(bvh, env, &Shading::new(bvh, &sp, dir), *strategy, false, s).0,

@@ -2,7 +2,7 @@
 //! the time budget is reached, and the AOVs of each pixel's centre ray.
 
 use crate::bvh::SceneBvh;
-use crate::integrator::{EnvLight, Integrator};
+use crate::integrator::{EnvLight, Integrator, Strategy};
 use crate::sampler::{PixelSampler, SamplerKind};
 use glam::Vec3;
 use rayon::prelude::*;
@@ -76,6 +76,10 @@ pub fn render(
     settings: &RenderSettings,
     progress: &(dyn Fn(u32, u32) + Sync),
 ) -> Render {
+    debug_assert!(
+        !(matches!(integrator, Integrator::EnvDirect(Strategy::EnvOnly)) && env.is_some_and(|e| e.compensated)),
+        "map-only sampling needs the complete distribution (EnvLight::for_strategy)"
+    );
     let (w, h) = (scene.camera.width, scene.camera.height);
     let cam = scene.camera.rays();
     let n = (w * h) as usize;
