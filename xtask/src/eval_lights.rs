@@ -88,7 +88,8 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
     if maps.is_empty() {
         return Err(format!("{}: no .exr or .hdr maps", args.maps.display()));
     }
-    let n_methods = chosen_methods(args.lights, &args.methods)?.len();
+    let methods = chosen_methods(args.lights, &args.methods)?;
+    let n_methods = methods.len();
     let bar = indicatif::ProgressBar::new((maps.len() * args.scenes.len() * (2 + n_methods)) as u64);
     bar.set_style(
         indicatif::ProgressStyle::with_template(
@@ -112,7 +113,7 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
         let map = load_map(Some(map_path))?;
         let map_name = map_path.file_name().map_or_else(String::new, |n| n.to_string_lossy().to_string());
         let env = EnvLight::new(&map);
-        let decompositions: Vec<_> = chosen_methods(args.lights, &args.methods)?
+        let decompositions: Vec<_> = methods
             .iter()
             .map(|(label, m)| {
                 let mut d = m.extract(&map).map_err(|e| format!("{}: {e}", map_path.display()))?;

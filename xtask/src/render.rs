@@ -165,12 +165,16 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         }
         other => return Err(format!("unknown integrator {other:?}: env-direct, lights or path")),
     };
+    let complete = match args.env_sampling.as_str() {
+        "compensated" => false,
+        "complete" => true,
+        other => return Err(format!("unknown env sampling {other:?}; available: compensated, complete")),
+    };
     // the lights integrator samples its lights, not the map
-    let env = match (&integrator, args.env_sampling.as_str()) {
-        (Integrator::Lights(_), _) => None,
-        (_, "compensated") => Some(EnvLight::new(&map)),
-        (_, "complete") => Some(EnvLight::complete(&map)),
-        (_, other) => return Err(format!("unknown env sampling {other:?}; available: compensated, complete")),
+    let env = match integrator {
+        Integrator::Lights(_) => None,
+        _ if complete => Some(EnvLight::complete(&map)),
+        _ => Some(EnvLight::new(&map)),
     };
     let bvh = SceneBvh::new(&scene);
     let bar = indicatif::ProgressBar::new(u64::from(args.spp));

@@ -150,6 +150,7 @@ pub struct EnvAliasDistribution {
     /// texel pdfs per steradian, row-major
     pdfs: Vec<f32>,
     row_cos: Vec<(f64, f64)>,
+    complete: bool,
 }
 
 impl EnvAliasDistribution {
@@ -169,7 +170,13 @@ impl EnvAliasDistribution {
             );
         }
         let pdfs = (0..h as usize).flat_map(|j| (0..w as usize).map(move |i| dist.texel_pdf(i, j))).collect();
-        Self { width: w, height: h, rows, cols, pdfs, row_cos: dist.row_cos().to_vec() }
+        Self { width: w, height: h, rows, cols, pdfs, row_cos: dist.row_cos().to_vec(), complete: dist.is_complete() }
+    }
+
+    /// [`EnvDistribution::is_complete`] of the distribution this was built from.
+    #[must_use]
+    pub fn is_complete(&self) -> bool {
+        self.complete
     }
 
     /// A direction drawn with `u` in [0, 1)^2 ([`EnvDistribution::sample_dir`]'s contract:

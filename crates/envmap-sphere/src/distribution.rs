@@ -147,15 +147,15 @@ pub struct EnvDistribution {
     /// per texel: pdf with respect to solid angle
     texel_pdf: Vec<f32>,
     row_cos: Vec<(f64, f64)>,
+    complete: bool,
 }
 
 impl EnvDistribution {
     /// Builds the distribution of `map`'s luminance x texel solid angle.
     #[must_use]
     pub fn new(map: &EnvMap) -> Self {
-        let (w, h) = (map.width(), map.height());
         let lum: Vec<f64> = map.pixels().iter().map(|p| f64::from(luminance(*p)).max(0.0)).collect();
-        Self::from_weights(map, &lum, w, h)
+        Self::from_weights(map, &lum, true)
     }
 
     /// A distribution for renderers that evaluate the map bilinearly ([`EnvMap::lookup`]): each
@@ -165,7 +165,7 @@ impl EnvDistribution {
     /// spreading the sun's samples over its neighbours.
     #[must_use]
     pub fn for_bilinear(map: &EnvMap) -> Self {
-        Self::from_weights(map, &bilinear_weights(map), map.width(), map.height())
+        Self::from_weights(map, &bilinear_weights(map), true)
     }
 
     /// [`for_bilinear`](Self::for_bilinear) with MIS compensation (Karlik et al. 2019,
@@ -181,25 +181,25 @@ impl EnvDistribution {
     /// map) has nothing above its mean and keeps the uncompensated distribution.
     #[must_use]
     pub fn for_bilinear_compensated(map: &EnvMap) -> Self {
-        let mut weights = bilinear_weights(map);
-        let sa = map.row_solid_angles();
-        let w = map.width() as usize;
-        let mean = weights.chunks(w).zip(&sa).map(|(row, sa)| row.iter().sum::<f64>() * sa).sum::<f64>()
-            / (4.0 * std::f64::consts::PI);
+        let weights = bilinear_weights(map);
+        let mean = solid_angle_integral(&weights, &map.row_solid_angles()) / (4.0 * std::f64::consts::PI);
         let compensated: Vec<f64> = weights.iter().map(|x| (x - mean).max(0.0)).collect();
         // float sums of equal weights can leave a mean a hair below them: positive residues
         // of a few ulps are not structure
         if compensated.iter().any(|&x| x > 1e-9 * mean) {
-            weights = compensated;
+            Self::from_weights(map, &compensated, false)
+        } else {
+            Self::from_weights(map, &weights, true)
         }
-        Self::from_weights(map, &weights, map.width(), map.height())
     }
 
-    /// The distribution of per-texel weights (row-major, non-negative) x texel solid angle.
-    fn from_weights(map: &EnvMap, lum: &[f64], w: u32, h: u32) -> Self {
+    /// The distribution of `map`'s per-texel weights (row-major, non-negative) x texel solid
+    /// angle; `complete` states that the weights are positive wherever the map is.
+    fn from_weights(map: &EnvMap, lum: &[f64], complete: bool) -> Self {
+        let (w, h) = (map.width(), map.height());
         let sa: Vec<f64> = map.row_solid_angles();
+        let total = solid_angle_integral(lum, &sa);
         let lum = |i: u32, j: u32| lum[j as usize * w as usize + i as usize];
-        let total: f64 = (0..h).map(|j| (0..w).map(|i| lum(i, j)).sum::<f64>() * sa[j as usize]).sum();
         let black = !(total.is_finite() && total > 0.0);
         let weight = |i: u32, j: u32| if black { sa[j as usize] } else { lum(i, j) * sa[j as usize] };
         let cols: Vec<Distribution1D> = (0..h).map(|j| Distribution1D::new((0..w).map(|i| weight(i, j)))).collect();
@@ -210,7 +210,14 @@ impl EnvDistribution {
             .map(|(i, j)| (weight(i, j) / sa[j as usize] / norm) as f32)
             .collect();
         let row_cos = (0..h).map(|j| row_cos_bounds(j, h)).collect();
-        Self { width: w, height: h, rows, cols, texel_pdf, row_cos }
+        Self { width: w, height: h, rows, cols, texel_pdf, row_cos, complete }
+    }
+
+    /// Whether the pdf is positive wherever the map has light: false after MIS compensation,
+    /// whose samples are valid only in MIS with a technique that covers the rest.
+    #[must_use]
+    pub fn is_complete(&self) -> bool {
+        self.complete
     }
 
     /// Probability of choosing texel (i, j).
@@ -288,6 +295,12 @@ impl EnvDistribution {
         let t = ((c0 - f64::from(d.y)) / (c0 - c1)).clamp(0.0, 1.0) as f32;
         (i, j, (x - i as f32).clamp(0.0, ONE_MINUS_EPSILON), t.min(ONE_MINUS_EPSILON))
     }
+}
+
+/// The integral over the sphere of per-texel values (row-major) given each row's texel solid
+/// angle.
+fn solid_angle_integral(values: &[f64], row_sa: &[f64]) -> f64 {
+    values.chunks(values.len() / row_sa.len().max(1)).zip(row_sa).map(|(row, sa)| row.iter().sum::<f64>() * sa).sum()
 }
 
 /// Per texel, row-major: the largest luminance in its 3 x 3 neighbourhood (wrapping in u,

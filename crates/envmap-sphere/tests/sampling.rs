@@ -357,6 +357,7 @@ fn compensated_pdf_is_the_weight_above_its_mean() {
         }
         assert!(zero > 0, "texels below the mean get no map samples");
         let alias = EnvAliasDistribution::new(&dist);
+        assert!(!dist.is_complete() && !alias.is_complete(), "the pdf says it is incomplete");
         let mut rng = common::rng(17);
         for _ in 0..100_000 {
             let s = alias.sample_dir(Vec2::new(rng.random(), rng.random()));
@@ -369,6 +370,7 @@ fn compensated_pdf_is_the_weight_above_its_mean() {
 fn compensating_a_constant_map_keeps_it_uniform() {
     for map in [EnvMap::constant(64, 32, Vec3::splat(3.0)), EnvMap::constant(8, 4, Vec3::ZERO)] {
         let dist = EnvDistribution::for_bilinear_compensated(&map);
+        assert!(dist.is_complete());
         let uniform = (1.0 / (4.0 * PI)) as f32;
         for j in 0..map.height() as usize {
             for i in 0..map.width() as usize {

@@ -33,11 +33,10 @@ pub enum Strategy {
 pub struct EnvLight<'a> {
     /// The map.
     pub map: &'a EnvMap,
-    /// Its importance sampling distribution, in alias form: O(1) draws.
+    /// Its importance sampling distribution, in alias form: O(1) draws. An incomplete one
+    /// (MIS-compensated) is valid with BRDF samples ([`Strategy::Mis`], path tracing), not for
+    /// [`Strategy::EnvOnly`].
     pub dist: EnvAliasDistribution,
-    /// Whether `dist` is MIS-compensated: incomplete, so valid only combined with BRDF samples
-    /// ([`Strategy::Mis`], path tracing), not for [`Strategy::EnvOnly`].
-    pub compensated: bool,
 }
 
 impl<'a> EnvLight<'a> {
@@ -46,15 +45,14 @@ impl<'a> EnvLight<'a> {
     /// the BRDF sample.
     #[must_use]
     pub fn new(map: &'a EnvMap) -> Self {
-        let dist = EnvAliasDistribution::new(&EnvDistribution::for_bilinear_compensated(map));
-        Self { map, dist, compensated: true }
+        Self { map, dist: EnvAliasDistribution::new(&EnvDistribution::for_bilinear_compensated(map)) }
     }
 
     /// The light with the complete distribution ([`EnvDistribution::for_bilinear`]: positive
     /// pdf wherever the map is), which map-only sampling needs.
     #[must_use]
     pub fn complete(map: &'a EnvMap) -> Self {
-        Self { map, dist: EnvAliasDistribution::new(&EnvDistribution::for_bilinear(map)), compensated: false }
+        Self { map, dist: EnvAliasDistribution::new(&EnvDistribution::for_bilinear(map)) }
     }
 
     /// The light `strategy` needs: complete for [`Strategy::EnvOnly`], compensated otherwise.

@@ -77,7 +77,7 @@ pub fn render(
     progress: &(dyn Fn(u32, u32) + Sync),
 ) -> Render {
     debug_assert!(
-        !(matches!(integrator, Integrator::EnvDirect(Strategy::EnvOnly)) && env.is_some_and(|e| e.compensated)),
+        !(matches!(integrator, Integrator::EnvDirect(Strategy::EnvOnly)) && env.is_some_and(|e| !e.dist.is_complete())),
         "map-only sampling needs the complete distribution (EnvLight::for_strategy)"
     );
     let (w, h) = (scene.camera.width, scene.camera.height);

@@ -34,13 +34,19 @@ pub enum SamplerKind {
 
 /// The numbers of one pixel sample.
 pub struct PixelSampler {
-    kind: SamplerKind,
-    rng: Pcg32,
     sample: u64,
-    /// hash of (seed, pixel): the Sobol scrambles derive from it per dimension pair
-    key: u64,
-    /// next Sobol dimension pair
-    pair: u64,
+    stream: Stream,
+}
+
+/// Where a [`PixelSampler`]'s numbers come from.
+enum Stream {
+    Independent(Pcg32),
+    Sobol {
+        /// hash of (seed, pixel): the scrambles derive from it per dimension pair
+        key: u64,
+        /// the last dimension pair drawn
+        pair: u64,
+    },
 }
 
 /// Laine and Karras's hash-based permutation that only lets a bit affect higher bits.
@@ -124,9 +130,15 @@ impl PixelSampler {
     #[must_use]
     pub fn with_kind(kind: SamplerKind, seed: u64, pixel: u64, sample: u64) -> Self {
         let pixel_key = mix(seed ^ mix(pixel.wrapping_add(0x9e37_79b9_7f4a_7c15)));
-        let key = pixel_key ^ mix(sample.wrapping_mul(0x2545_f491_4f6c_dd1d));
-        // state and stream straight from the key: cheaper than seed_from_u64's seeding PCG
-        Self { kind, rng: Pcg32::new(key, mix(key ^ 0xda3e_39cb_94b9_5bdb)), sample, key: pixel_key, pair: 0 }
+        let stream = match kind {
+            SamplerKind::Independent => {
+                let key = pixel_key ^ mix(sample.wrapping_mul(0x2545_f491_4f6c_dd1d));
+                // state and stream straight from the key: cheaper than seed_from_u64's seeding PCG
+                Stream::Independent(Pcg32::new(key, mix(key ^ 0xda3e_39cb_94b9_5bdb)))
+            }
+            SamplerKind::Sobol => Stream::Sobol { key: pixel_key, pair: 0 },
+        };
+        Self { sample, stream }
     }
 
     /// The index of the pixel sample this stream belongs to (for stratifying a discrete choice
@@ -136,33 +148,34 @@ impl PixelSampler {
         self.sample
     }
 
-    /// The next dimension pair's Sobol point, scrambled (as 32-bit fractions).
-    fn sobol_2d(&mut self) -> (u32, u32) {
-        self.pair += 1;
-        let h = mix(self.key ^ mix(self.pair.wrapping_mul(0x9e37_79b9_7f4a_7c15)));
+    /// The next dimension pair's scrambled Sobol point (as 32-bit fractions) of sample
+    /// `sample`.
+    fn sobol_2d(sample: u64, key: u64, pair: &mut u64) -> (u32, u32) {
+        *pair += 1;
+        let h = mix(key ^ mix(pair.wrapping_mul(0x9e37_79b9_7f4a_7c15)));
         let h2 = mix(h);
         // shuffling the index by an Owen scramble keeps every aligned block of 2^m samples a
         // block of the sequence, so a pixel's first 2^m samples stay a net
-        let index = owen_scramble(self.sample as u32, h as u32);
+        let index = owen_scramble(sample as u32, h as u32);
         let (x, y) = sobol_pair(index);
         (owen_scramble(x, (h >> 32) as u32), owen_scramble(y, h2 as u32))
     }
 
     /// A number in [0, 1).
     pub fn next_1d(&mut self) -> f32 {
-        match self.kind {
+        match &mut self.stream {
             // 24 random bits: exactly representable, never 1.0
-            SamplerKind::Independent => to_unit(self.rng.random::<u32>()),
-            SamplerKind::Sobol => to_unit(self.sobol_2d().0),
+            Stream::Independent(rng) => to_unit(rng.random::<u32>()),
+            Stream::Sobol { key, pair } => to_unit(Self::sobol_2d(self.sample, *key, pair).0),
         }
     }
 
     /// A point in [0, 1)^2.
     pub fn next_2d(&mut self) -> Vec2 {
-        match self.kind {
-            SamplerKind::Independent => Vec2::new(self.next_1d(), self.next_1d()),
-            SamplerKind::Sobol => {
-                let (x, y) = self.sobol_2d();
+        match &mut self.stream {
+            Stream::Independent(rng) => Vec2::new(to_unit(rng.random::<u32>()), to_unit(rng.random::<u32>())),
+            Stream::Sobol { key, pair } => {
+                let (x, y) = Self::sobol_2d(self.sample, *key, pair);
                 Vec2::new(to_unit(x), to_unit(y))
             }
         }
