@@ -7,7 +7,7 @@
 use crate::render::load_map;
 use light_extract::{EmissiveSplit, LightExtractor};
 use ref_tracer::metrics::{FlipTonemap, flip, rmse};
-use ref_tracer::{EnvLight, Integrator, LightSet, RenderSettings, SceneBvh, Strategy};
+use ref_tracer::{AmbientMap, EnvLight, Integrator, LightSet, RenderSettings, SceneBvh, Strategy};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -50,8 +50,9 @@ fn chosen_methods(k: usize, only: &[String]) -> Result<Vec<Method>, String> {
 }
 
 /// (label, extractor): Table 1's methods, then Table 2's ablation of EmissiveSplit, then our
-/// above-horizon options (not the papers': only the hemisphere above the ground reaches the
-/// receivers).
+/// options (not the papers'): above-horizon (only the hemisphere above the ground reaches the
+/// receivers), moment cones, and the residual as the remainder (median cut's too, for a fair
+/// comparison).
 fn methods(k: usize) -> Vec<Method> {
     let es = EmissiveSplit { lights: k, ..EmissiveSplit::default() };
     let ablations: [(&str, Box<dyn LightExtractor>); 3] = [
@@ -69,7 +70,9 @@ fn methods(k: usize) -> Vec<Method> {
                 "emissive-split+above-horizon",
                 "emissive-split+moment-cones",
                 "emissive-split+moment-cones+above-horizon",
+                "emissive-split+moment-cones+above-horizon+residual",
                 "median-cut+above-horizon",
+                "median-cut+above-horizon+residual",
             ]
             .into_iter()
             .filter_map(named),
@@ -122,7 +125,8 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
                 let sets = d.interleaved_distant_lights();
                 Ok::<_, String>((d, sets))
             })
-            .collect::<Result<_, _>>()?;
+            .collect::<Result<Vec<_>, _>>()?;
+        let ambient_maps: Vec<_> = decompositions.iter().map(|(d, _)| AmbientMap::new(&d.ambient)).collect();
         for (scene_name, scene, bvh) in &scenes {
             bar.set_message(format!("{map_name} / {scene_name}"));
             // Every render goes through the same lights_spp sub-pixel positions, so a method's
@@ -158,13 +162,14 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
                 flip: flip(&reference.color, &floor.color, floor.width, floor.height, &tm),
                 extract_ms: 0.0,
             });
-            for (d, sets) in &decompositions {
+            for ((d, sets), ambient_map) in decompositions.iter().zip(&ambient_maps) {
                 let lights = d.distant_lights();
 
                 let set = LightSet {
                     lights: &lights,
                     interleaved: sets,
                     ambient: Some(d.ambient_sh),
+                    ambient_map: Some(ambient_map),
                     shadow_ambient: false,
                     background: Some(&map),
                 };

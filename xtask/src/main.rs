@@ -62,8 +62,9 @@ enum Command {
         path: PathBuf,
         /// emissive-split, center-surround (stops by Weber's law; K is a cap), median-cut,
         /// variance-min or importance; append +above-horizon to model only the hemisphere above
-        /// the ground (for scenes standing on an opaque ground), and to emissive-split
-        /// +moment-cones (before +above-horizon) for cones matching each cluster's spread.
+        /// the ground (for scenes standing on an opaque ground), to emissive-split
+        /// +moment-cones (before +above-horizon) for cones matching each cluster's spread, and
+        /// last +residual to make ambient.exr the signed residual, map minus lights.
         #[arg(long, default_value = "median-cut")]
         method: String,
         /// Number of lights K (median cut uses the largest power of two not above K).

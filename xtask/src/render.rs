@@ -2,10 +2,10 @@
 //! summary line; and `cargo xtask compare REF TEST`: RMSE and FLIP.
 
 use crate::parse_size;
-use envmap_sphere::{EnvMap, Sh9, Tonemap};
+use envmap_sphere::{EnvMap, LoadOptions, NegativePolicy, Sh9, Tonemap};
 use glam::Vec3;
 use ref_tracer::metrics::{FlipTonemap, flip, rmse};
-use ref_tracer::{EnvLight, Integrator, LightSet, RenderSettings, SamplerKind, SceneBvh, Strategy};
+use ref_tracer::{AmbientMap, EnvLight, Integrator, LightSet, RenderSettings, SamplerKind, SceneBvh, Strategy};
 use scene::{DistantLight, Scene};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -83,6 +83,8 @@ pub struct LightsData {
     pub lights: Vec<DistantLight>,
     pub interleaved: Vec<Vec<DistantLight>>,
     pub ambient: Option<Sh9>,
+    /// The `ambient.exr` itself, for the specular lobe.
+    pub ambient_map: Option<EnvMap>,
 }
 
 #[derive(Deserialize)]
@@ -118,19 +120,22 @@ fn parse_lights(path: &Path, entries: &[LightEntry]) -> Result<Vec<DistantLight>
 
 /// Lights from a `lights.json` (the light-extract schema; `lights[]` and `interleaved[][]` with
 /// their `direction`, `solid_angle` and `radiance` are read) and, when an `ambient.exr` sits
-/// beside it, its SH9.
+/// beside it, that map and its SH9.
 pub fn load_lights(path: &Path) -> Result<LightsData, String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let file: LightsFile = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
     let lights = parse_lights(path, &file.lights)?;
     let interleaved = file.interleaved.iter().map(|set| parse_lights(path, set)).collect::<Result<_, _>>()?;
     let ambient_path = path.with_file_name("ambient.exr");
-    let ambient = if ambient_path.exists() {
-        Some(Sh9::project(&EnvMap::load(&ambient_path).map_err(|e| e.to_string())?))
+    // signed when it is a residual (`+residual`): negative values are data, not ringing
+    let signed = LoadOptions { negative: NegativePolicy::Keep, ..LoadOptions::default() };
+    let ambient_map = if ambient_path.exists() {
+        Some(EnvMap::load_with(&ambient_path, &signed).map_err(|e| e.to_string())?.0)
     } else {
         None
     };
-    Ok(LightsData { lights, interleaved, ambient })
+    let ambient = ambient_map.as_ref().map(Sh9::project);
+    Ok(LightsData { lights, interleaved, ambient, ambient_map })
 }
 
 pub fn run(args: &RenderArgs) -> Result<(), String> {
@@ -150,6 +155,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         Some(p) => Some(load_lights(p)?),
         None => None,
     };
+    let ambient_map = light_data.as_ref().and_then(|d| d.ambient_map.as_ref()).map(AmbientMap::new);
     let integrator = match args.integrator.as_str() {
         "env-direct" => Integrator::EnvDirect(Strategy::Mis),
         "path" => Integrator::Path { max_depth: args.max_depth.max(1) },
@@ -159,6 +165,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
                 lights: &data.lights,
                 interleaved: &data.interleaved,
                 ambient: data.ambient,
+                ambient_map: ambient_map.as_ref(),
                 shadow_ambient: args.shadow_ambient,
                 background: Some(&map),
             })

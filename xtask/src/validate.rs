@@ -164,6 +164,8 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
         lights: &lights,
         interleaved: &sets,
         ambient: Some(decomposition.ambient_sh),
+        // the GPU pass shades the ambient by SH9 alone
+        ambient_map: None,
         shadow_ambient: false,
         background: Some(&map),
     };

@@ -1,6 +1,6 @@
 //! The commands as a user runs them: output shape, exit codes, one-line errors.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn xtask(args: &[&str]) -> Output {
@@ -214,23 +214,42 @@ fn extract_writes_the_four_files_and_a_line_per_light() {
     }
     // the lights feed the reference tracer's lights integrator
     let img = dir.join("r.exr");
-    let json = dir.join("lights.json");
+    let render = |scene: &str, json: &Path| {
+        let out = xtask(&[
+            "render",
+            "--scene",
+            scene,
+            "--size",
+            "32x24",
+            "--spp",
+            "2",
+            "--integrator",
+            "lights",
+            "--lights",
+            json.to_str().unwrap_or_default(),
+            "--out",
+            img.to_str().unwrap_or_default(),
+        ]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    };
+    render("spheres_box", &dir.join("lights.json"));
+    // +residual: a signed ambient.exr, which render reads with its signs
+    let residual = dir.join("residual");
     let out = xtask(&[
-        "render",
-        "--scene",
-        "spheres_box",
-        "--size",
-        "32x24",
-        "--spp",
-        "2",
-        "--integrator",
-        "lights",
+        "extract",
+        map.to_str().unwrap_or_default(),
+        "--method",
+        "median-cut+above-horizon+residual",
         "--lights",
-        json.to_str().unwrap_or_default(),
+        "16",
         "--out",
-        img.to_str().unwrap_or_default(),
+        residual.to_str().unwrap_or_default(),
     ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let keep = envmap_sphere::LoadOptions { negative: envmap_sphere::NegativePolicy::Keep, ..Default::default() };
+    let (ambient, _) = envmap_sphere::EnvMap::load_with(residual.join("ambient.exr"), &keep).expect("ambient.exr");
+    assert!(ambient.pixels().iter().any(|p| p.min_element() < 0.0), "the residual is signed");
+    render("glossy_set", &residual.join("lights.json"));
     let out = xtask(&["extract", map.to_str().unwrap_or_default(), "--method", "nope"]);
     assert_eq!(out.status.code(), Some(1));
     assert!(
@@ -257,7 +276,7 @@ fn eval_lights_writes_both_tables_with_a_noise_floor() {
     let csv = std::fs::read_to_string(out_dir.join("eval-lights.csv")).expect("csv");
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines[0], "map,scene,method,lights,rmse,converged_rmse,flip,extract_ms");
-    assert_eq!(lines.len(), 1 + 13, "floor + five methods + three ablations + four of our options: {csv}");
+    assert_eq!(lines.len(), 1 + 15, "floor + five methods + three ablations + six of our options: {csv}");
     for ablation in ["emissive-split/no-masking", "emissive-split/no-kmeans", "emissive-split/neither"] {
         assert!(csv.contains(&format!(",{ablation},")), "{ablation} missing:\n{csv}");
     }
@@ -271,7 +290,9 @@ fn eval_lights_writes_both_tables_with_a_noise_floor() {
         "emissive-split+above-horizon",
         "emissive-split+moment-cones",
         "emissive-split+moment-cones+above-horizon",
+        "emissive-split+moment-cones+above-horizon+residual",
         "median-cut+above-horizon",
+        "median-cut+above-horizon+residual",
     ] {
         assert!(csv.contains(&format!(",{method},")), "{method} missing:\n{csv}");
     }

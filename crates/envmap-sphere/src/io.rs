@@ -10,7 +10,8 @@
 //! - negative values: lossy EXR compression (DWAB) rings slightly below zero; by default they are
 //!   clamped to zero and the count and the fraction of power removed are reported, unless the
 //!   negative power exceeds [`DEFAULT_MAX_NEGATIVE_FRACTION`] of the positive power (a broken
-//!   file). [`NegativePolicy::Strict`] refuses any negative value.
+//!   file). [`NegativePolicy::Strict`] refuses any negative value; [`NegativePolicy::Keep`]
+//!   keeps them, for signed maps (a residual of light extraction).
 
 use crate::envmap::EnvMap;
 use crate::error::EnvMapError;
@@ -46,6 +47,9 @@ pub enum NegativePolicy {
     },
     /// Refuse any negative value.
     Strict,
+    /// Keep negative values as they are: for signed maps, such as the residual of light
+    /// extraction (map minus lights), not for radiance.
+    Keep,
 }
 
 impl Default for NegativePolicy {
@@ -408,6 +412,10 @@ fn sanitize(
     }
     let fraction = if positive > 0.0 { negative / positive } else { f64::INFINITY };
     let limit = match options.negative {
+        NegativePolicy::Keep => {
+            report.negative_power_fraction = fraction;
+            return Ok(());
+        }
         NegativePolicy::Strict => 0.0,
         NegativePolicy::Clamp { max_power_fraction } => max_power_fraction,
     };

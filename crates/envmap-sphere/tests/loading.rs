@@ -56,6 +56,11 @@ fn dwab_negative_ringing_is_clamped_and_reported() {
         let strict = LoadOptions { negative: NegativePolicy::Strict, ..LoadOptions::default() };
         let err = EnvMap::load_with(&path, &strict).expect_err("strict mode refuses negatives");
         assert!(matches!(err, EnvMapError::Negative { count: c, .. } if c == count), "{err}");
+        let keep = LoadOptions { negative: NegativePolicy::Keep, ..LoadOptions::default() };
+        let (signed, report) = EnvMap::load_with(&path, &keep).unwrap_or_else(|e| panic!("{e}"));
+        let kept = signed.pixels().iter().map(|p| p.to_array().iter().filter(|c| **c < 0.0).count()).sum::<usize>();
+        assert_eq!((kept, report.negatives_clamped), (count, 0), "{name}: signed maps keep their values");
+        assert!(signed.pixels().iter().zip(map.pixels()).all(|(s, c)| s.max(Vec3::ZERO) == *c));
     }
 }
 

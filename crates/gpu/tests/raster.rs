@@ -94,6 +94,7 @@ fn shading_matches_ref_tracer_lights_without_shadows() {
         lights: &lights,
         interleaved: &[],
         ambient: Some(ambient),
+        ambient_map: None,
         shadow_ambient: false,
         background: Some(&sky),
     };

@@ -19,6 +19,7 @@ use crate::decomposition::{Decomposition, ExtractError, LightExtractor};
 use envmap_sphere::EnvMap;
 use glam::Vec3;
 use scene::DistantLight;
+use std::borrow::Cow;
 use std::time::Instant;
 
 /// Runs `inner` on the map with every texel whose centre lies below the horizon set to zero.
@@ -147,5 +148,9 @@ impl<E: LightExtractor> LightExtractor for AboveHorizon<E> {
             fill_budget: self.fill_budget,
             narrow_at_horizon: self.narrow_at_horizon,
         }))
+    }
+
+    fn modelled_map<'m>(&self, map: &'m EnvMap) -> Cow<'m, EnvMap> {
+        Cow::Owned(upper_hemisphere(map, self.up.normalize_or_zero()))
     }
 }

@@ -7,6 +7,7 @@ use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg32;
 use scene::DistantLight;
 use scene::brdf::Frame;
+use std::borrow::Cow;
 
 /// One extracted light: a distant cone and the extent of the pixel cluster it stands for.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -166,6 +167,12 @@ pub trait LightExtractor {
         let _ = lights;
         None
     }
+
+    /// The part of `map` the lights and remainder stand for (what the books cover): the map
+    /// itself, except for wrappers that hand their inner method less ([`crate::AboveHorizon`]).
+    fn modelled_map<'m>(&self, map: &'m EnvMap) -> Cow<'m, EnvMap> {
+        Cow::Borrowed(map)
+    }
 }
 
 impl<T: LightExtractor + ?Sized> LightExtractor for Box<T> {
@@ -179,5 +186,9 @@ impl<T: LightExtractor + ?Sized> LightExtractor for Box<T> {
 
     fn with_budget(&self, lights: usize) -> Option<Box<dyn LightExtractor>> {
         (**self).with_budget(lights)
+    }
+
+    fn modelled_map<'m>(&self, map: &'m EnvMap) -> Cow<'m, EnvMap> {
+        (**self).modelled_map(map)
     }
 }

@@ -15,7 +15,9 @@
 //!   k-means), the rest -> EnvIndirects (an illumination cut over a binary light tree).
 //!
 //! [`AboveHorizon`] wraps any of them (our option, not a paper's): for scenes on an opaque
-//! ground it models only the hemisphere that can reach the receivers.
+//! ground it models only the hemisphere that can reach the receivers. [`Residual`] (ours too)
+//! keeps any method's lights for the shadows and makes the remainder the signed residual, map
+//! minus lights, so glossy surfaces reflect the map's detail the cones average away.
 //!
 //! Outputs: [`Decomposition::to_json`] (`lights.json`), [`Decomposition::to_gltf`] (glTF 2.0 with
 //! `KHR_lights_punctual` directional lights), the remainder map (`ambient.exr`) and an overlay of
@@ -40,6 +42,7 @@ mod median_cut;
 pub mod output;
 pub mod overlay;
 mod regions;
+mod residual;
 mod variance;
 
 pub use above_horizon::{AboveHorizon, narrow_to_horizon, upper_hemisphere};
@@ -50,6 +53,7 @@ pub use decomposition::{
 pub use emissive_split::EmissiveSplit;
 pub use importance::ImportanceSampled;
 pub use median_cut::MedianCut;
+pub use residual::{Residual, splat_lights};
 pub use variance::VarianceMinimization;
 
 /// The methods by name, as `lights.json` and the commands name them.
@@ -57,14 +61,17 @@ pub const METHODS: [&str; 5] = ["emissive-split", "center-surround", "median-cut
 
 /// Our options (not the papers'), appended to a method's name with `+`: `moment-cones`
 /// (emissive split only, [`EmissiveSplit::moment_cones`]), then `above-horizon` (any method,
-/// [`AboveHorizon`]).
-pub const OPTIONS: [&str; 2] = ["moment-cones", "above-horizon"];
+/// [`AboveHorizon`]), then `residual` (any method, [`Residual`]).
+pub const OPTIONS: [&str; 3] = ["moment-cones", "above-horizon", "residual"];
 
 /// The extractor named `method` (one of [`METHODS`], optionally followed by [`OPTIONS`] in that
-/// order, e.g. `emissive-split+moment-cones+above-horizon`) with a budget of `k` lights and the
+/// order, e.g. `emissive-split+moment-cones+above-horizon+residual`) with a budget of `k` lights and the
 /// papers' defaults otherwise; `None` for an unknown name or option.
 #[must_use]
 pub fn extractor(method: &str, k: usize) -> Option<Box<dyn LightExtractor>> {
+    if let Some(inner) = method.strip_suffix("+residual") {
+        return Some(Box::new(Residual::new(extractor(inner, k)?)));
+    }
     let (base, above_horizon) = method.strip_suffix("+above-horizon").map_or((method, false), |b| (b, true));
     let inner: Box<dyn LightExtractor> = match base {
         "emissive-split" => Box::new(EmissiveSplit { lights: k, ..EmissiveSplit::default() }),

@@ -4,8 +4,9 @@
 //!   sample and one BRDF sample with the power heuristic; the truth approximations are measured
 //!   against. `Strategy` isolates either technique for tests.
 //! - `Lights`: direct illumination from distant cone lights with ray-traced visibility (cone
-//!   sampling, combined by MIS with a BRDF sample on glossy surfaces), plus an SH9 ambient term
-//!   (unshadowed, or shadowed by cosine-sampled visibility).
+//!   sampling, combined by MIS with a BRDF sample on glossy surfaces), plus an ambient term: SH9
+//!   irradiance on the diffuse lobe, the ambient map through the BRDF sample on the specular
+//!   lobe (unshadowed, or shadowed by sampled visibility).
 //! - `Path`: multi-bounce path tracing with the same MIS next-event estimation at every vertex.
 //!
 //! Surfaces do not emit; the map is the only light of `EnvDirect` and `Path`.
@@ -71,13 +72,47 @@ pub struct LightSet<'a> {
     /// multiple of the set count each set lights a pixel equally often: the converged result of
     /// interleaving followed by a perfect filter. Empty: `lights` only.
     pub interleaved: &'a [Vec<DistantLight>],
-    /// Ambient radiance as SH9 (its irradiance lights the diffuse lobe), if any.
+    /// Ambient radiance as SH9 (its irradiance lights the diffuse lobe), if any. It may be
+    /// signed (a residual, see `light_extract::Residual`): its irradiance is added unclamped.
     pub ambient: Option<Sh9>,
+    /// The ambient radiance itself, which lights the specular lobe of glossy surfaces (and,
+    /// when shadowed, the diffuse lobe's visibility samples): what a prefiltered specular map
+    /// gives a renderer, without its approximation. `None`: only the lights reach the specular
+    /// lobe.
+    pub ambient_map: Option<&'a AmbientMap<'a>>,
     /// Shadow the ambient term by sampling visibility (cosine-weighted) instead of leaving it
     /// unshadowed.
     pub shadow_ambient: bool,
     /// What camera rays that miss see (the original map, usually).
     pub background: Option<&'a EnvMap>,
+}
+
+impl<'a> LightSet<'a> {
+    /// `lights` alone: no interleaved sets, no ambient, a black background.
+    #[must_use]
+    pub fn new(lights: &'a [DistantLight]) -> Self {
+        Self { lights, interleaved: &[], ambient: None, ambient_map: None, shadow_ambient: false, background: None }
+    }
+}
+
+/// An ambient map, possibly signed (a residual), with a distribution of its magnitude: the
+/// specular lobe's share of it is estimated by MIS of one sample of that distribution and the
+/// BRDF sample, so a residual's spikes (a sun narrower than its light's cone) add no more noise
+/// than the sun does to `EnvDirect`.
+pub struct AmbientMap<'a> {
+    /// The radiance.
+    pub map: &'a EnvMap,
+    /// Samples |radiance| (luminance), complete.
+    pub dist: EnvAliasDistribution,
+}
+
+impl<'a> AmbientMap<'a> {
+    /// `map` and the distribution of its magnitude.
+    #[must_use]
+    pub fn new(map: &'a EnvMap) -> Self {
+        let magnitude = EnvMap::from_texels(map.width(), map.height(), |i, j| map.pixel(i, j).abs());
+        Self { map, dist: EnvAliasDistribution::new(&EnvDistribution::for_bilinear(&magnitude)) }
+    }
 }
 
 /// An integrator and its parameters.
@@ -260,24 +295,50 @@ fn lights_direct(bvh: &SceneBvh, set: &LightSet, sh: &Shading, s: &mut PixelSamp
             // cosine sampling: estimate of albedo/pi * integral L V cos = albedo * L(wi) V
             let wi = sh.frame.to_world(scene::brdf::sample_cosine_hemisphere(s.next_2d()));
             if wi.dot(sh.ng) > 0.0 && !bvh.occluded(sh.origin(), wi, f32::INFINITY) {
-                l += diffuse * sh9.eval(wi).max(Vec3::ZERO);
+                // the map where there is one; SH9 radiance rings below zero near bright texels
+                l += diffuse * set.ambient_map.map_or_else(|| sh9.eval(wi).max(Vec3::ZERO), |a| a.map.lookup(wi));
             }
         } else {
-            l += diffuse * sh9.irradiance(sh.frame.n).max(Vec3::ZERO) * std::f32::consts::FRAC_1_PI;
+            l += diffuse * sh9.irradiance(sh.frame.n) * std::f32::consts::FRAC_1_PI;
         }
     }
-    if glossy && let Some((wi, pdf)) = sh.material.sample_brdf(sh.wo, s.next_2d(), s.next_1d()) {
+    if !glossy {
+        return l;
+    }
+    let (u_brdf, u_lobe) = (s.next_2d(), s.next_1d());
+    let u_ambient = set.ambient_map.map(|_| s.next_2d());
+    if let Some((wi, pdf)) = sh.material.sample_brdf(sh.wo, u_brdf, u_lobe) {
         let wi_world = sh.frame.to_world(wi);
-        let (fc, _) = sh.f_cos(wi_world);
-        let mut seen = Vec3::ZERO;
-        for light in lights.iter().filter(|light| light.contains(wi_world)) {
-            seen += light.radiance * power_heuristic(pdf, 1.0 / light.solid_angle);
+        let (fc, wi) = sh.f_cos(wi_world);
+        if fc != Vec3::ZERO {
+            let mut seen = Vec3::ZERO;
+            for light in lights.iter().filter(|light| light.contains(wi_world)) {
+                seen += light.radiance * power_heuristic(pdf, 1.0 / light.solid_angle);
+            }
+            let ambient = set.ambient_map.map_or(Vec3::ZERO, |a| {
+                let w = power_heuristic(pdf, a.dist.dir_pdf(wi_world));
+                sh.material.eval_specular(sh.wo, wi) * wi.z * a.map.lookup(wi_world) * (w / pdf)
+            });
+            l += arriving(bvh, sh, wi_world, fc * seen / pdf, ambient, set.shadow_ambient);
         }
-        if fc != Vec3::ZERO && seen != Vec3::ZERO && !bvh.occluded(sh.origin(), wi_world, f32::INFINITY) {
-            l += fc * seen / pdf;
+    }
+    if let (Some(a), Some(u)) = (set.ambient_map, u_ambient) {
+        let ls = a.dist.sample_dir(u);
+        let (fc, wi) = sh.f_cos(ls.dir);
+        if ls.pdf > 0.0 && fc != Vec3::ZERO {
+            let w = power_heuristic(ls.pdf, sh.material.brdf_pdf(sh.wo, wi));
+            let ambient = sh.material.eval_specular(sh.wo, wi) * wi.z * a.map.lookup_uv(ls.uv) * (w / ls.pdf);
+            l += arriving(bvh, sh, ls.dir, Vec3::ZERO, ambient, set.shadow_ambient);
         }
     }
     l
+}
+
+/// What arrives from `dir`: `lit` (light, always shadowed) and `ambient` (shadowed only when
+/// asked), one shadow ray at most.
+fn arriving(bvh: &SceneBvh, sh: &Shading, dir: Vec3, lit: Vec3, ambient: Vec3, shadow_ambient: bool) -> Vec3 {
+    let (shadowed, free) = if shadow_ambient { (lit + ambient, Vec3::ZERO) } else { (lit, ambient) };
+    if shadowed != Vec3::ZERO && !bvh.occluded(sh.origin(), dir, f32::INFINITY) { free + shadowed } else { free }
 }
 
 fn path(bvh: &SceneBvh, env: &EnvLight, origin: Vec3, dir: Vec3, max_depth: u32, s: &mut PixelSampler) -> Vec3 {

@@ -34,6 +34,6 @@ pub mod sampler;
 pub mod visibility;
 
 pub use bvh::{SceneBvh, SurfacePoint};
-pub use integrator::{EnvLight, Integrator, LightSet, Strategy};
+pub use integrator::{AmbientMap, EnvLight, Integrator, LightSet, Strategy};
 pub use render::{Render, RenderSettings, render};
 pub use sampler::SamplerKind;

@@ -205,8 +205,7 @@ fn one_light_over_the_whole_sphere_equals_the_constant_map() {
     let l = Vec3::new(0.5, 1.0, 2.0);
     let map = EnvMap::constant(32, 16, l);
     let lights = [DistantLight { direction: Vec3::Y, solid_angle: 4.0 * std::f32::consts::PI, radiance: l }];
-    let set =
-        LightSet { lights: &lights, interleaved: &[], ambient: None, shadow_ambient: false, background: Some(&map) };
+    let set = LightSet { background: Some(&map), ..LightSet::new(&lights) };
     let (m_lights, e1) = image_mean(&scene, &map, &Integrator::Lights(set), 16, 8);
     let (m_env, e2) = image_mean(&scene, &map, &Integrator::EnvDirect(Strategy::Mis), 16, 8);
     let sigma = (e1 * e1 + e2 * e2).sqrt();
@@ -239,7 +238,7 @@ fn a_tiny_cone_shades_like_a_directional_light() {
         solid_angle: omega,
         radiance: Vec3::splat(1.0 / omega),
     }];
-    let set = LightSet { lights: &lights, interleaved: &[], ambient: None, shadow_ambient: false, background: None };
+    let set = LightSet::new(&lights);
     let r = run(&plane, None, &Integrator::Lights(set), 4, 2);
     let want = 0.6 / std::f32::consts::PI * theta.cos();
     for c in &r.color {
@@ -252,7 +251,7 @@ fn shared_pixel_positions_leave_no_antialiasing_noise() {
     // Unshadowed SH9 ambient is deterministic shading: the only randomness left is where the
     // camera rays cross each pixel, which the spheres' silhouettes make visible.
     let sh = Sh9::project(&envmap_sphere::default_map());
-    let set = || LightSet { lights: &[], interleaved: &[], ambient: Some(sh), shadow_ambient: false, background: None };
+    let set = || LightSet { ambient: Some(sh), ..LightSet::new(&[]) };
     let scene = small("spheres_box", 40, 30);
     let settings =
         |seed, pixel_positions| RenderSettings { spp: 4, seed, aovs: false, pixel_positions, ..Default::default() };
@@ -278,7 +277,7 @@ fn interleaved_sets_are_stratified_over_a_pixels_samples() {
         radiance: Vec3::splat(l / omega),
     };
     let (a, b) = ([light(10.0, 1.0)], vec![vec![light(60.0, 3.0)]]);
-    let set = LightSet { lights: &a, interleaved: &b, ambient: None, shadow_ambient: false, background: None };
+    let set = LightSet { interleaved: &b, ..LightSet::new(&a) };
     let r = run(&scene, None, &Integrator::Lights(set), 2, 3);
     let albedo = scene.objects[0].material.albedo.x;
     let want = albedo / std::f32::consts::PI * (10f32.to_radians().cos() + 3.0 * 60f32.to_radians().cos()) / 2.0;
@@ -296,7 +295,7 @@ fn ambient_sh9_lights_the_diffuse_lobe() {
     let sh = Sh9::project(&EnvMap::constant(64, 32, l));
     let mut scene = small("three_boxes", 16, 12);
     scene.objects.truncate(1); // the ground alone
-    let set = LightSet { lights: &[], interleaved: &[], ambient: Some(sh), shadow_ambient: false, background: None };
+    let set = LightSet { ambient: Some(sh), ..LightSet::new(&[]) };
     let r = run(&scene, None, &Integrator::Lights(set), 1, 0);
     for (k, c) in r.color.iter().enumerate() {
         if interior(&r, k, 0) {
@@ -304,7 +303,7 @@ fn ambient_sh9_lights_the_diffuse_lobe() {
         }
     }
     // Shadowed by sampling, it converges to the same on an unoccluded plane.
-    let set = LightSet { lights: &[], interleaved: &[], ambient: Some(sh), shadow_ambient: true, background: None };
+    let set = LightSet { ambient: Some(sh), shadow_ambient: true, ..LightSet::new(&[]) };
     let r = run(&scene, None, &Integrator::Lights(set), 64, 0);
     let (mean, n) = object_mean(&r, 0);
     assert!(n > 50 && (mean - l * 0.5).abs().max_element() < 0.01, "{mean}");
@@ -366,7 +365,7 @@ fn glossy_lights_match_the_map_of_their_cones() {
     let map =
         EnvMap::from_fn(2048, 1024, |d| [a, b].iter().filter(|l| l.contains(d)).map(|l| l.radiance).sum::<Vec3>());
     let lights = [a, b];
-    let set = || LightSet { lights: &lights, interleaved: &[], ambient: None, shadow_ambient: false, background: None };
+    let set = || LightSet::new(&lights);
     let objects = [(3u32, "semi_glossy_sphere"), (4, "glossy_box")];
     let stats = |integrator: &Integrator, spp: u32| {
         let runs: Vec<Vec<Vec3>> = (0..6)

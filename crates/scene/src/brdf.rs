@@ -141,16 +141,20 @@ impl Material {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return Vec3::ZERO;
         }
-        let mut f = self.eval_diffuse(wo, wi);
-        if let Some(g) = self.specular {
-            let a = alpha(g.roughness);
-            let h = (wo + wi).normalize_or_zero();
-            if h != Vec3::ZERO {
-                let spec = ggx_d(h, a) * ggx_g2(wo, wi, a) / (4.0 * wo.z * wi.z);
-                f += fresnel_schlick(g.f0, wo.dot(h)) * spec;
-            }
+        self.eval_diffuse(wo, wi) + self.eval_specular(wo, wi)
+    }
+
+    /// The specular (GGX) lobe's value for local directions (both above the surface); zero
+    /// without a specular layer.
+    #[must_use]
+    pub fn eval_specular(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        let Some(g) = self.specular else { return Vec3::ZERO };
+        let a = alpha(g.roughness);
+        let h = (wo + wi).normalize_or_zero();
+        if h == Vec3::ZERO {
+            return Vec3::ZERO;
         }
-        f
+        fresnel_schlick(g.f0, wo.dot(h)) * (ggx_d(h, a) * ggx_g2(wo, wi, a) / (4.0 * wo.z * wi.z))
     }
 
     /// Density (solid angle) with which [`Material::sample_brdf`] returns `wi`.
