@@ -13,6 +13,10 @@
 //!   "interleaved": [ [ light, ... ], ... ] }   // the extra sets of interleaved sampling
 //! ```
 //!
+//! `ambient.exr` is the remainder: non-negative, except for `+residual` methods, whose remainder
+//! is the signed residual map - lights (read it without clamping negatives, e.g.
+//! `NegativePolicy::Keep`).
+//!
 //! `power` is radiance x solid angle: the irradiance the light gives a surface facing it. In
 //! `lights.gltf` each light is a `KHR_lights_punctual` directional light whose node's -Z axis
 //! points the way the light travels (away from `direction`); `intensity` is the luminance

@@ -171,24 +171,27 @@ fn lights_and_residual_render_a_lone_glossy_sphere_like_the_map() {
         let mean = |v: &[Vec3]| v.iter().map(|p| f64::from(p.element_sum())).sum::<f64>();
         (metrics::rmse(&a, &b), mean(&b) / mean(&a))
     };
-    let lit = |ambient_map| {
+    let lit = |ambient_map, shadow_ambient| {
         let set = LightSet {
             lights: &lights,
             interleaved: &sets,
             ambient: Some(d.ambient_sh),
             ambient_map,
-            shadow_ambient: false,
+            shadow_ambient,
             background: Some(&map),
         };
         let seed = RenderSettings { seed: 2, ..settings };
         compare(&render(&scene, &bvh, None, &Integrator::Lights(set), &seed, &|_, _| {}).color)
     };
-    let (with, with_ratio) = lit(Some(&ambient));
-    let (without, _) = lit(None);
+    let (with, with_ratio) = lit(Some(&ambient), false);
+    let (without, _) = lit(None, false);
+    // nothing occludes a lone convex sphere: shadowing the ambient changes nothing but noise
+    let (shadowed, shadowed_ratio) = lit(Some(&ambient), true);
     let seed = RenderSettings { seed: 3, ..settings };
     let (floor, _) =
         compare(&render(&scene, &bvh, Some(&env), &Integrator::EnvDirect(Strategy::Mis), &seed, &|_, _| {}).color);
     assert!((with_ratio - 1.0).abs() < 0.02, "mean ratio {with_ratio}");
     assert!(with < 2.0 * floor, "with the residual {with}, noise floor {floor}");
     assert!(without > 4.0 * with, "without the residual {without}, with {with}");
+    assert!((shadowed_ratio - 1.0).abs() < 0.02 && shadowed < 2.0 * floor, "shadowed: {shadowed} {shadowed_ratio}");
 }

@@ -104,6 +104,8 @@ pub struct AmbientMap<'a> {
     pub map: &'a EnvMap,
     /// Samples |radiance| (luminance), complete.
     pub dist: EnvAliasDistribution,
+    /// Pairs of a map sample and a BRDF sample per pixel sample ([`AmbientMap::SAMPLES`]).
+    pub samples: u32,
 }
 
 impl<'a> AmbientMap<'a> {
@@ -111,8 +113,15 @@ impl<'a> AmbientMap<'a> {
     #[must_use]
     pub fn new(map: &'a EnvMap) -> Self {
         let magnitude = EnvMap::from_texels(map.width(), map.height(), |i, j| map.pixel(i, j).abs());
-        Self { map, dist: EnvAliasDistribution::new(&EnvDistribution::for_bilinear(&magnitude)) }
+        Self {
+            map,
+            dist: EnvAliasDistribution::new(&EnvDistribution::for_bilinear(&magnitude)),
+            samples: Self::SAMPLES,
+        }
     }
+
+    /// Default pairs of samples per pixel sample: unshadowed, they cost map look-ups only.
+    pub const SAMPLES: u32 = 4;
 }
 
 /// An integrator and its parameters.
@@ -305,33 +314,47 @@ fn lights_direct(bvh: &SceneBvh, set: &LightSet, sh: &Shading, s: &mut PixelSamp
     if !glossy {
         return l;
     }
-    let (u_brdf, u_lobe) = (s.next_2d(), s.next_1d());
-    let u_ambient = set.ambient_map.map(|_| s.next_2d());
-    if let Some((wi, pdf)) = sh.material.sample_brdf(sh.wo, u_brdf, u_lobe) {
+    if let Some((wi, pdf)) = sh.material.sample_brdf(sh.wo, s.next_2d(), s.next_1d()) {
         let wi_world = sh.frame.to_world(wi);
-        let (fc, wi) = sh.f_cos(wi_world);
-        if fc != Vec3::ZERO {
-            let mut seen = Vec3::ZERO;
-            for light in lights.iter().filter(|light| light.contains(wi_world)) {
-                seen += light.radiance * power_heuristic(pdf, 1.0 / light.solid_angle);
-            }
-            let ambient = set.ambient_map.map_or(Vec3::ZERO, |a| {
-                let w = power_heuristic(pdf, a.dist.dir_pdf(wi_world));
-                sh.material.eval_specular(sh.wo, wi) * wi.z * a.map.lookup(wi_world) * (w / pdf)
-            });
-            l += arriving(bvh, sh, wi_world, fc * seen / pdf, ambient, set.shadow_ambient);
+        let (fc, _) = sh.f_cos(wi_world);
+        let mut seen = Vec3::ZERO;
+        for light in lights.iter().filter(|light| light.contains(wi_world)) {
+            seen += light.radiance * power_heuristic(pdf, 1.0 / light.solid_angle);
         }
+        l += arriving(bvh, sh, wi_world, fc * seen / pdf, Vec3::ZERO, false);
     }
-    if let (Some(a), Some(u)) = (set.ambient_map, u_ambient) {
-        let ls = a.dist.sample_dir(u);
-        let (fc, wi) = sh.f_cos(ls.dir);
-        if ls.pdf > 0.0 && fc != Vec3::ZERO {
-            let w = power_heuristic(ls.pdf, sh.material.brdf_pdf(sh.wo, wi));
-            let ambient = sh.material.eval_specular(sh.wo, wi) * wi.z * a.map.lookup_uv(ls.uv) * (w / ls.pdf);
-            l += arriving(bvh, sh, ls.dir, Vec3::ZERO, ambient, set.shadow_ambient);
-        }
+    if let Some(a) = set.ambient_map {
+        l += specular_ambient(bvh, sh, a, set.shadow_ambient, s);
     }
     l
+}
+
+/// The specular lobe's share of the ambient map: `a.samples` pairs of a BRDF sample and a map
+/// sample, power heuristic. Unshadowed, the samples trace no ray, so several are cheap next to
+/// the lights' shadow rays; they average out a residual's positive and negative parts (a sun
+/// and the cone that replaced it), which one pair would estimate with much noise.
+fn specular_ambient(bvh: &SceneBvh, sh: &Shading, a: &AmbientMap, shadow: bool, s: &mut PixelSampler) -> Vec3 {
+    let mut l = Vec3::ZERO;
+    // f_spec cos L / pdf with the power-heuristic weight of the pdfs (this, other)
+    let term = |wi: Vec3, radiance: Vec3, pdf: f32, other: f32| {
+        sh.material.eval_specular(sh.wo, wi) * wi.z * radiance * (power_heuristic(pdf, other) / pdf)
+    };
+    for _ in 0..a.samples {
+        if let Some((wi, pdf)) = sh.material.sample_brdf(sh.wo, s.next_2d(), s.next_1d()) {
+            let dir = sh.frame.to_world(wi);
+            if sh.f_cos(dir).0 != Vec3::ZERO {
+                let t = term(wi, a.map.lookup(dir), pdf, a.dist.dir_pdf(dir));
+                l += arriving(bvh, sh, dir, Vec3::ZERO, t, shadow);
+            }
+        }
+        let ls = a.dist.sample_dir(s.next_2d());
+        let (fc, wi) = sh.f_cos(ls.dir);
+        if ls.pdf > 0.0 && fc != Vec3::ZERO {
+            let t = term(wi, a.map.lookup_uv(ls.uv), ls.pdf, sh.material.brdf_pdf(sh.wo, wi));
+            l += arriving(bvh, sh, ls.dir, Vec3::ZERO, t, shadow);
+        }
+    }
+    l / a.samples.max(1) as f32
 }
 
 /// What arrives from `dir`: `lit` (light, always shadowed) and `ambient` (shadowed only when
