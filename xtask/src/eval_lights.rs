@@ -126,7 +126,13 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
                 Ok::<_, String>((d, sets))
             })
             .collect::<Result<Vec<_>, _>>()?;
-        let ambient_maps: Vec<_> = decompositions.iter().map(|(d, _)| AmbientMap::new(&d.ambient)).collect();
+        // a black remainder (a partition into lights) lights nothing: no samples spent on it
+        let ambient_maps: Vec<_> = decompositions
+            .iter()
+            .map(|(d, _)| {
+                d.ambient.pixels().iter().any(|p| *p != glam::Vec3::ZERO).then(|| AmbientMap::new(&d.ambient))
+            })
+            .collect();
         for (scene_name, scene, bvh) in &scenes {
             bar.set_message(format!("{map_name} / {scene_name}"));
             // Every render goes through the same lights_spp sub-pixel positions, so a method's
@@ -169,7 +175,7 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
                     lights: &lights,
                     interleaved: sets,
                     ambient: Some(d.ambient_sh),
-                    ambient_map: Some(ambient_map),
+                    ambient_map: ambient_map.as_ref(),
                     shadow_ambient: false,
                     background: Some(&map),
                 };
