@@ -50,8 +50,9 @@ impl<E> Residual<E> {
 pub fn splat_lights(lights: &[DistantLight], width: u32, height: u32) -> Vec<Vec3> {
     let mut out = vec![Vec3::ZERO; (width as usize) * (height as usize)];
     let solid = |j: u32| envmap_sphere::latlong::latlong_texel_solid_angle(j, width, height);
+    let dirs = envmap_sphere::latlong::TexelDirections::new(width, height);
     for light in lights {
-        let texels = cone_texels(light, width, height);
+        let texels = cone_texels(light, &dirs, width, height);
         let omega: f64 = texels.iter().map(|&(_, j)| solid(j)).sum();
         let (texels, omega) = if omega > 0.0 {
             (texels, omega)
@@ -70,13 +71,17 @@ pub fn splat_lights(lights: &[DistantLight], width: u32, height: u32) -> Vec<Vec
 
 /// The texels whose centres lie in `light`'s cone, row by row: per row only the columns within
 /// the cone's azimuth span are tested.
-fn cone_texels(light: &DistantLight, width: u32, height: u32) -> Vec<(u32, u32)> {
+fn cone_texels(
+    light: &DistantLight,
+    dirs: &envmap_sphere::latlong::TexelDirections,
+    width: u32,
+    height: u32,
+) -> Vec<(u32, u32)> {
     let d = light.direction.normalize_or(Vec3::Y);
     let cos_max = light.cos_half_angle();
     let half = light.half_angle();
     let theta_c = d.y.clamp(-1.0, 1.0).acos();
     let phi_c = envmap_sphere::latlong::atan2(d.x, -d.z).rem_euclid(TAU);
-    let dirs = envmap_sphere::latlong::TexelDirections::new(width, height);
     let row = |theta: f32| ((theta / PI * height as f32 - 0.5).floor().max(0.0) as u32).min(height - 1);
     let (j0, j1) = (row(theta_c - half), row(theta_c + half) + 1);
     let mut texels = Vec::new();

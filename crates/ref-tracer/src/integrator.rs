@@ -5,8 +5,8 @@
 //!   against. `Strategy` isolates either technique for tests.
 //! - `Lights`: direct illumination from distant cone lights with ray-traced visibility (cone
 //!   sampling, combined by MIS with a BRDF sample on glossy surfaces), plus an ambient term: SH9
-//!   irradiance on the diffuse lobe, the ambient map through the BRDF sample on the specular
-//!   lobe (unshadowed, or shadowed by sampled visibility).
+//!   irradiance on the diffuse lobe, the ambient map on the specular lobe by MIS pairs of a map
+//!   sample and a BRDF sample (unshadowed, or shadowed by sampled visibility).
 //! - `Path`: multi-bounce path tracing with the same MIS next-event estimation at every vertex.
 //!
 //! Surfaces do not emit; the map is the only light of `EnvDirect` and `Path`.
@@ -96,9 +96,9 @@ impl<'a> LightSet<'a> {
 }
 
 /// An ambient map, possibly signed (a residual), with a distribution of its magnitude: the
-/// specular lobe's share of it is estimated by MIS of one sample of that distribution and the
-/// BRDF sample, so a residual's spikes (a sun narrower than its light's cone) add no more noise
-/// than the sun does to `EnvDirect`.
+/// specular lobe's share of it is estimated by MIS of samples of that distribution and BRDF
+/// samples, so a residual's spikes (a sun narrower than its light's cone) are found as `EnvDirect`
+/// finds the sun.
 pub struct AmbientMap<'a> {
     /// The radiance.
     pub map: &'a EnvMap,
