@@ -122,17 +122,11 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
                 let mut d = m.extract(&map).map_err(|e| format!("{}: {e}", map_path.display()))?;
                 d.method.clone_from(label);
                 // paper 001, section 3.5: 8 sets; the extra 7 as renderers take them
-                let sets = d.interleaved_distant_lights();
-                Ok::<_, String>((d, sets))
+                let (lights, sets) = (d.distant_lights(), d.interleaved_distant_lights());
+                Ok::<_, String>((d, lights, sets))
             })
             .collect::<Result<Vec<_>, _>>()?;
-        // a black remainder (a partition into lights) lights nothing: no samples spent on it
-        let ambient_maps: Vec<_> = decompositions
-            .iter()
-            .map(|(d, _)| {
-                d.ambient.pixels().iter().any(|p| *p != glam::Vec3::ZERO).then(|| AmbientMap::new(&d.ambient))
-            })
-            .collect();
+        let ambient_maps: Vec<_> = decompositions.iter().map(|(d, _, _)| AmbientMap::new(&d.ambient)).collect();
         for (scene_name, scene, bvh) in &scenes {
             bar.set_message(format!("{map_name} / {scene_name}"));
             // Every render goes through the same lights_spp sub-pixel positions, so a method's
@@ -168,11 +162,9 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
                 flip: flip(&reference.color, &floor.color, floor.width, floor.height, &tm),
                 extract_ms: 0.0,
             });
-            for ((d, sets), ambient_map) in decompositions.iter().zip(&ambient_maps) {
-                let lights = d.distant_lights();
-
+            for ((d, lights, sets), ambient_map) in decompositions.iter().zip(&ambient_maps) {
                 let set = LightSet {
-                    lights: &lights,
+                    lights,
                     interleaved: sets,
                     ambient: Some(d.ambient_sh),
                     ambient_map: ambient_map.as_ref(),

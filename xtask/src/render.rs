@@ -155,7 +155,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         Some(p) => Some(load_lights(p)?),
         None => None,
     };
-    let ambient_map = light_data.as_ref().and_then(|d| d.ambient_map.as_ref()).map(AmbientMap::new);
+    let ambient_map = light_data.as_ref().and_then(|d| d.ambient_map.as_ref()).and_then(AmbientMap::new);
     let integrator = match args.integrator.as_str() {
         "env-direct" => Integrator::EnvDirect(Strategy::Mis),
         "path" => Integrator::Path { max_depth: args.max_depth.max(1) },

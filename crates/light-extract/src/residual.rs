@@ -14,7 +14,7 @@
 //! (`<method>+residual` in `lights.json`).
 
 use crate::decomposition::{
-    Decomposition, ExtractError, ExtractedLight, INTERLEAVED_JITTER, INTERLEAVED_SETS, LightExtractor, interleaved_sets,
+    Decomposition, ExtractError, INTERLEAVED_JITTER, INTERLEAVED_SETS, LightExtractor, interleaved_sets,
 };
 use envmap_sphere::{EnvMap, Sh9};
 use glam::Vec3;
@@ -121,14 +121,13 @@ impl<E: LightExtractor> LightExtractor for Residual<E> {
         let mut d = self.inner.extract(map)?;
         let modelled = self.inner.modelled_map(map);
         let (w, h) = (map.width(), map.height());
-        let sets: Vec<Vec<ExtractedLight>> = interleaved_sets(&d.lights, self.sets, INTERLEAVED_JITTER, 0);
+        // the splat is linear: the mean of the sets' splats is the splat of all their lights
+        let all: Vec<DistantLight> =
+            interleaved_sets(&d.lights, self.sets, INTERLEAVED_JITTER, 0).iter().flatten().map(|l| l.light).collect();
         let mut residual = modelled.into_owned();
         let scale = 1.0 / self.sets as f32;
-        for set in &sets {
-            let lights: Vec<DistantLight> = set.iter().map(|l| l.light).collect();
-            for (r, s) in residual.pixels_mut().iter_mut().zip(splat_lights(&lights, w, h)) {
-                *r -= s * scale;
-            }
+        for (r, s) in residual.pixels_mut().iter_mut().zip(splat_lights(&all, w, h)) {
+            *r -= s * scale;
         }
         d.ambient_sh = Sh9::project(&residual);
         d.ambient = residual;

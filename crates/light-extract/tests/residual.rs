@@ -163,7 +163,7 @@ fn lights_and_residual_render_a_lone_glossy_sphere_like_the_map() {
         .extract(&map)
         .unwrap();
     let (lights, sets) = (d.distant_lights(), d.interleaved_distant_lights());
-    let ambient = AmbientMap::new(&d.ambient);
+    let ambient = AmbientMap::new(&d.ambient).expect("a residual that is not black");
     // (RMSE, ratio of means) against the truth over the sphere's pixels
     let sphere: Vec<usize> = (0..truth.color.len()).filter(|&k| truth.object_id[k] == 0).collect();
     let compare = |img: &[Vec3]| {

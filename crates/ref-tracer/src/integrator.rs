@@ -109,15 +109,19 @@ pub struct AmbientMap<'a> {
 }
 
 impl<'a> AmbientMap<'a> {
-    /// `map` and the distribution of its magnitude.
+    /// `map` and the distribution of its magnitude; `None` for an all-zero map (the remainder
+    /// of a partition into lights), which lights nothing and is worth no samples.
     #[must_use]
-    pub fn new(map: &'a EnvMap) -> Self {
+    pub fn new(map: &'a EnvMap) -> Option<Self> {
+        if map.pixels().iter().all(|p| *p == Vec3::ZERO) {
+            return None;
+        }
         let magnitude = EnvMap::from_texels(map.width(), map.height(), |i, j| map.pixel(i, j).abs());
-        Self {
+        Some(Self {
             map,
             dist: EnvAliasDistribution::new(&EnvDistribution::for_bilinear(&magnitude)),
             samples: Self::SAMPLES,
-        }
+        })
     }
 
     /// Default pairs of samples per pixel sample: unshadowed, they cost map look-ups only.
