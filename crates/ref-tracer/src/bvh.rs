@@ -1,11 +1,12 @@
 //! The scene's triangles in an obvhs compressed-wide BVH: closest-hit and occlusion queries,
 //! and the surface point of a hit.
 
-use glam::{Vec3, Vec3A};
+use glam::{UVec2, Vec3, Vec3A};
 use obvhs::BvhBuildParams;
 use obvhs::cwbvh::CwBvh;
 use obvhs::cwbvh::builder::build_cwbvh_from_tris;
-use obvhs::ray::{Ray, RayHit};
+use obvhs::cwbvh::node::CwBvhNode;
+use obvhs::ray::Ray;
 use obvhs::triangle::Triangle;
 use scene::{Material, Mesh, Scene};
 
@@ -30,7 +31,7 @@ pub struct SceneBvh {
     bvh: CwBvh,
     /// the triangles in the BVH's primitive order, so a leaf's triangles sit side by side in
     /// memory and need no index lookup
-    triangles: Vec<Triangle>,
+    triangles: Vec<RtTriangle>,
     /// per triangle, in the same order: (object, triangle within the object)
     owners: Vec<(u32, u32)>,
     materials: Vec<Material>,
@@ -46,7 +47,7 @@ impl SceneBvh {
     pub fn new(scene: &Scene) -> Self {
         let mut triangles = Vec::with_capacity(scene.triangle_count());
         let mut owners = Vec::with_capacity(scene.triangle_count());
-        let mut scale = 1.0f32;
+        let mut scale = 0.0f32;
         for (k, o) in scene.objects.iter().enumerate() {
             for t in 0..o.mesh.indices.len() {
                 let [a, b, c] = o.mesh.triangle(t);
@@ -56,7 +57,7 @@ impl SceneBvh {
             }
         }
         let bvh = build_cwbvh_from_tris(&triangles, BvhBuildParams::very_slow_build(), &mut Default::default());
-        let triangles = bvh.primitive_indices.iter().map(|&i| triangles[i as usize]).collect();
+        let triangles = bvh.primitive_indices.iter().map(|&i| RtTriangle::new(&triangles[i as usize])).collect();
         let owners = bvh.primitive_indices.iter().map(|&i| owners[i as usize]).collect();
         Self {
             bvh,
@@ -84,32 +85,45 @@ impl SceneBvh {
     /// The closest hit along `origin + t dir`, t in (0, t_max).
     #[must_use]
     pub fn intersect(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<SurfacePoint> {
-        let ray = Ray::new(origin.into(), dir.into(), 0.0, t_max);
-        let mut hit = RayHit::none();
-        let found = self.bvh.ray_traverse(ray, &mut hit, |r, id| self.triangles[id].intersect(r));
-        if !found {
-            return None;
-        }
-        Some(self.surface(hit.primitive_id as usize, origin, dir, hit.t))
+        let mut ray = Ray::new(origin.into(), dir.into(), 0.0, t_max);
+        let mut hit = None;
+        let mut state = self.bvh.new_traversal(ray.direction);
+        let mut node: &CwBvhNode;
+        obvhs::traverse!(self.bvh, node, state, node_hits(node, &ray, state.oct_inv4), {
+            let t = self.triangles[state.primitive_id as usize].intersect(&ray);
+            if t < ray.tmax {
+                hit = Some(state.primitive_id);
+                ray.tmax = t;
+            }
+        });
+        hit.map(|id| self.surface(id as usize, origin, dir, ray.tmax))
     }
 
     /// Whether anything blocks `origin + t dir` for t in (0, t_max).
     #[must_use]
     pub fn occluded(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
         let ray = Ray::new(origin.into(), dir.into(), 0.0, t_max);
-        !self.bvh.ray_traverse_miss(ray, |r, id| self.triangles[id].intersect(r))
+        let mut state = self.bvh.new_traversal(ray.direction);
+        let mut node: &CwBvhNode;
+        let mut blocked = false;
+        obvhs::traverse!(self.bvh, node, state, node_hits(node, &ray, state.oct_inv4), {
+            if self.triangles[state.primitive_id as usize].intersect(&ray) < ray.tmax {
+                blocked = true;
+                break;
+            }
+        });
+        blocked
     }
 
     fn surface(&self, tri_index: usize, origin: Vec3, dir: Vec3, t: f32) -> SurfacePoint {
         let tri = &self.triangles[tri_index];
-        let (v0, v1, v2) = (Vec3::from(tri.v0), Vec3::from(tri.v1), Vec3::from(tri.v2));
         let position = origin + dir * t;
-        let mut ng = (v1 - v0).cross(v2 - v0).normalize_or(Vec3::Y);
+        let mut ng = tri.n.normalize_or(Vec3::Y);
         let (object, local) = self.owners[tri_index];
         let mesh = &self.meshes[object as usize];
         let mut ns = match &mesh.normals {
             Some(normals) => {
-                let b = barycentric(Vec3A::from(position), tri);
+                let b = barycentric(position, tri);
                 let [i0, i1, i2] = mesh.indices[local as usize].map(|i| normals[i as usize]);
                 (i0 * b.x + i1 * b.y + i2 * b.z).normalize_or(ng)
             }
@@ -126,11 +140,89 @@ impl SceneBvh {
 }
 
 /// Barycentric coordinates (w0, w1, w2) of a point in the triangle's plane.
-fn barycentric(p: Vec3A, tri: &Triangle) -> Vec3 {
-    let (e1, e2, d) = (tri.v1 - tri.v0, tri.v2 - tri.v0, p - tri.v0);
-    let n = e1.cross(e2);
+fn barycentric(p: Vec3, tri: &RtTriangle) -> Vec3 {
+    let (e1, e2, n, d) = (tri.e1, tri.e2, tri.n, p - tri.v0);
     let inv = 1.0 / n.length_squared();
     let b1 = d.cross(e2).dot(n) * inv;
     let b2 = e1.cross(d).dot(n) * inv;
     Vec3::new(1.0 - b1 - b2, b1, b2)
+}
+
+/// A triangle as the intersection test reads it: one vertex, the two edges from it and their
+/// cross product, precomputed once instead of per test.
+#[derive(Clone, Copy, Debug)]
+struct RtTriangle {
+    v0: Vec3,
+    e1: Vec3,
+    e2: Vec3,
+    /// e1 x e2, unnormalized
+    n: Vec3,
+}
+
+impl RtTriangle {
+    fn new(t: &Triangle) -> Self {
+        let (v0, e1, e2) = (Vec3::from(t.v0), Vec3::from(t.v1 - t.v0), Vec3::from(t.v2 - t.v0));
+        Self { v0, e1, e2, n: e1.cross(e2) }
+    }
+
+    /// Distance to the hit within (ray.tmin, ray.tmax], infinity for none: Moller-Trumbore
+    /// with the edges and normal precomputed. A hit exactly on an edge counts (u, v, w >= 0),
+    /// so the shared edges of a mesh leave no cracks.
+    #[inline(always)]
+    fn intersect(&self, ray: &Ray) -> f32 {
+        let (o, d) = (Vec3::from(ray.origin), Vec3::from(ray.direction));
+        let c = self.v0 - o;
+        let r = d.cross(c);
+        let det = -self.n.dot(d);
+        let inv_det = 1.0 / det;
+        let u = r.dot(self.e2) * inv_det;
+        let v = -r.dot(self.e1) * inv_det;
+        let t = -self.n.dot(c) * inv_det;
+        let inside = u >= 0.0 && v >= 0.0 && u + v <= 1.0;
+        if inside && det != 0.0 && t > ray.tmin && t <= ray.tmax { t } else { f32::INFINITY }
+    }
+}
+
+/// `a.max(b)` as one vector instruction: `f32::max`'s NaN rule costs extra ones, and a NaN
+/// here (a zero extent times an infinite inverse) rightly reads as a miss either way.
+#[inline(always)]
+fn fast_max(a: f32, b: f32) -> f32 {
+    if a > b { a } else { b }
+}
+
+#[inline(always)]
+fn fast_min(a: f32, b: f32) -> f32 {
+    if a < b { a } else { b }
+}
+
+/// Which children of a compressed wide node the ray enters, as the hit mask obvhs's `traverse!`
+/// expects: all eight slabs in one pass over arrays, which LLVM turns into one AVX2 (or two
+/// SSE) vector pass, where obvhs's own test assembles each lane from scalars. The slab test
+/// starts at the ray's `tmin` (obvhs's clamps at a fixed 1e-4, which drops boxes closer than
+/// that in tiny scenes).
+#[inline(always)]
+fn node_hits(node: &CwBvhNode, ray: &Ray, oct_inv4: u32) -> u32 {
+    let scale = node.compute_extent() * ray.inv_direction;
+    let offset = (Vec3A::from(node.p) - ray.origin) * ray.inv_direction;
+    // near and far planes per axis: the ray's sign picks which quantized bound is which
+    let planes = |lo: &[u8; 8], hi: &[u8; 8], negative: bool| if negative { (*hi, *lo) } else { (*lo, *hi) };
+    let (nx, fx) = planes(&node.child_min_x, &node.child_max_x, ray.direction.x < 0.0);
+    let (ny, fy) = planes(&node.child_min_y, &node.child_max_y, ray.direction.y < 0.0);
+    let (nz, fz) = planes(&node.child_min_z, &node.child_max_z, ray.direction.z < 0.0);
+    let (child_bits8, bit_index8) = node.get_child_and_index_bits(oct_inv4);
+    let (child_bits8, bit_index8) = (child_bits8.to_le_bytes(), bit_index8.to_le_bytes());
+    let mut hits = [0u32; 8];
+    for i in 0..8 {
+        let t_near = fast_max(
+            fast_max(f32::from(nx[i]) * scale.x + offset.x, f32::from(ny[i]) * scale.y + offset.y),
+            fast_max(f32::from(nz[i]) * scale.z + offset.z, ray.tmin),
+        );
+        let t_far = fast_min(
+            fast_min(f32::from(fx[i]) * scale.x + offset.x, f32::from(fy[i]) * scale.y + offset.y),
+            fast_min(f32::from(fz[i]) * scale.z + offset.z, ray.tmax),
+        );
+        let child = u32::from(child_bits8[i]) << bit_index8[i];
+        hits[i] = if t_near <= t_far { child } else { 0 };
+    }
+    hits.iter().fold(0, |a, b| a | b)
 }
