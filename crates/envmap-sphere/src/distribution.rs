@@ -252,11 +252,6 @@ impl EnvDistribution {
         self.cols[j].cell_probability(i)
     }
 
-    /// Each row's cos theta bounds (top, bottom).
-    pub(crate) fn row_cos(&self) -> &[(f64, f64)] {
-        &self.row_cos
-    }
-
     /// The pdf per steradian of texel (i, j).
     #[must_use]
     pub fn texel_pdf(&self, i: usize, j: usize) -> f32 {

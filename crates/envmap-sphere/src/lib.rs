@@ -10,8 +10,8 @@
 //!   [`EnvMap::irradiance`], [`EnvMap::luminance_stats`]); [`Sh9`] projection and the
 //!   Ramamoorthy-Hanrahan irradiance.
 //! - Sampling in pbrt's style ([`EnvDistribution`]: `sample_dir` / `dir_pdf` /
-//!   `invert_dir_sample`), its O(1) alias form for renderers ([`EnvAliasDistribution`]), and a
-//!   [`SummedAreaTable`] with f64 sums.
+//!   `invert_dir_sample`, O(1) on average through guide tables, monotonic so stratified points
+//!   stay stratified), and a [`SummedAreaTable`] with f64 sums.
 //! - [`default_map`]: a real CC0 map embedded in the library.
 //!
 //! Conventions (docs/conventions.md): right-handed, +Y up; linear Rec.709 radiance;
@@ -31,7 +31,6 @@
 //! assert!(sample.pdf > 0.0);
 //! ```
 
-pub mod alias;
 pub mod color;
 pub mod cube;
 mod default;
@@ -47,7 +46,6 @@ pub mod sat;
 pub mod sh;
 pub mod tonemap;
 
-pub use alias::{AliasTable, EnvAliasDistribution};
 pub use color::luminance;
 pub use default::{DEFAULT_MAP_CREDIT, DEFAULT_MAP_NAME, default_map, default_map_bytes};
 pub use distribution::{DirSample, Distribution1D, EnvDistribution};

@@ -4,9 +4,7 @@ mod common;
 
 use envmap_sphere::distribution::ONE_MINUS_EPSILON;
 use envmap_sphere::latlong::row_cos_bounds;
-use envmap_sphere::{
-    AliasTable, Distribution1D, EnvAliasDistribution, EnvDistribution, EnvMap, SummedAreaTable, luminance,
-};
+use envmap_sphere::{Distribution1D, EnvDistribution, EnvMap, SummedAreaTable, luminance};
 use glam::{Vec2, Vec3};
 use rand::Rng;
 use std::f64::consts::PI;
@@ -92,13 +90,6 @@ fn chi_square_samples_match_the_pdf() {
     chi_square_test(&map, |u| dist.sample_dir(u).dir);
 }
 
-#[test]
-fn alias_chi_square_samples_match_the_pdf() {
-    let map = test_map();
-    let dist = EnvAliasDistribution::new(&EnvDistribution::new(&map));
-    chi_square_test(&map, |u| dist.sample_dir(u).dir);
-}
-
 /// Chi-square test of a sampler of `map`'s luminance x solid angle, at 2 x 2 sub-cells per
 /// texel (so the placement inside a texel is tested too).
 fn chi_square_test(map: &EnvMap, sample: impl Fn(Vec2) -> Vec3) {
@@ -178,22 +169,18 @@ fn no_nan_at_extremes() {
     let edges = [0.0, f32::MIN_POSITIVE, 0.5, ONE_MINUS_EPSILON, 1.0];
     for map in &maps {
         let dist = EnvDistribution::new(map);
-        let alias = EnvAliasDistribution::new(&dist);
         for &a in &edges {
             for &b in &edges {
                 let s = dist.sample_dir(Vec2::new(a, b));
                 assert!(s.dir.is_finite() && (s.dir.length() - 1.0).abs() < 1e-5, "u = ({a}, {b}): {s:?}");
                 assert!(s.pdf.is_finite() && s.pdf > 0.0, "u = ({a}, {b}): {s:?}");
                 assert!(dist.invert_dir_sample(s.dir).is_finite());
-                let a = alias.sample_dir(Vec2::new(a, b));
-                assert!(a.dir.is_finite() && (a.dir.length() - 1.0).abs() < 1e-5, "alias: {a:?}");
-                assert!(a.pdf.is_finite() && a.pdf > 0.0 && a.pdf == alias.uv_pdf(a.uv), "alias: {a:?}");
+                assert_eq!(s.pdf, dist.uv_pdf(s.uv), "u = ({a}, {b}): {s:?}");
             }
         }
         for d in [Vec3::Y, Vec3::NEG_Y, Vec3::NEG_Z, Vec3::new(-1e-9, 0.0, -1.0), Vec3::new(1e-30, 1.0, 0.0)] {
             assert!(dist.dir_pdf(d).is_finite(), "{d}");
             assert!(dist.invert_dir_sample(d).is_finite(), "{d}");
-            assert_eq!(alias.dir_pdf(d), dist.dir_pdf(d), "{d}");
         }
     }
 }
@@ -356,11 +343,10 @@ fn compensated_pdf_is_the_weight_above_its_mean() {
             }
         }
         assert!(zero > 0, "texels below the mean get no map samples");
-        let alias = EnvAliasDistribution::new(&dist);
-        assert!(!dist.is_complete() && !alias.is_complete(), "the pdf says it is incomplete");
+        assert!(!dist.is_complete(), "the pdf says it is incomplete");
         let mut rng = common::rng(17);
         for _ in 0..100_000 {
-            let s = alias.sample_dir(Vec2::new(rng.random(), rng.random()));
+            let s = dist.sample_dir(Vec2::new(rng.random(), rng.random()));
             assert!(s.pdf > 0.0 && s.pdf == dist.uv_pdf(s.uv), "sample in a zero-pdf texel at {}", s.uv);
         }
     }
@@ -378,69 +364,4 @@ fn compensating_a_constant_map_keeps_it_uniform() {
             }
         }
     }
-}
-
-#[test]
-fn alias_table_probabilities_match_weights() {
-    let mut rng = common::rng(14);
-    for len in [1usize, 2, 7, 100, 1000] {
-        let weights = spiky_weights(len, &mut rng);
-        let table = AliasTable::new(&weights);
-        let total: f64 = weights.iter().sum();
-        for (k, w) in weights.iter().enumerate() {
-            assert!((table.probability(k) - w / total).abs() < 1e-6, "len {len} cell {k}");
-        }
-        // zero cells are never drawn, and the remapped number stays in [0, 1)
-        for step in 0..=20_000 {
-            let u = (step as f32 / 20_000.0).min(ONE_MINUS_EPSILON);
-            let (cell, r) = table.sample(u);
-            assert!(weights[cell] > 0.0 || total == 0.0, "len {len} u {u}: zero cell {cell}");
-            assert!((0.0..1.0).contains(&r));
-        }
-    }
-    // all-zero and non-finite weights: uniform over the cells
-    let table = AliasTable::new(&[0.0, f64::NAN, -1.0, 0.0]);
-    assert!((0..4).all(|k| (table.probability(k) - 0.25).abs() < 1e-12));
-}
-
-#[test]
-fn alias_remapped_number_is_uniform() {
-    // The second output of a draw places the sample inside its cell: it must be uniform for
-    // each cell, including cells reached through other bins' aliases.
-    let table = AliasTable::new(&[1.0, 7.0, 0.5, 3.0, 0.0, 2.5]);
-    let mut counts = [[0u32; 4]; 6];
-    let n = 600_000;
-    let mut rng = common::rng(15);
-    for _ in 0..n {
-        let (cell, r) = table.sample(rng.random());
-        counts[cell][(r * 4.0) as usize] += 1;
-    }
-    for (cell, quarters) in counts.iter().enumerate() {
-        let total: u32 = quarters.iter().sum();
-        let want = f64::from(n) * table.probability(cell);
-        assert!((f64::from(total) - want).abs() < 5.0 * want.sqrt() + 1.0, "cell {cell}: {total} vs {want}");
-        for q in quarters {
-            let want = f64::from(total) / 4.0;
-            assert!((f64::from(*q) - want).abs() < 5.0 * want.sqrt() + 1.0, "cell {cell}: {quarters:?}");
-        }
-    }
-}
-
-#[test]
-fn alias_sample_pdf_matches_pdf() {
-    let map = envmap_sphere::default_map();
-    let cdf = EnvDistribution::for_bilinear(&map);
-    let alias = EnvAliasDistribution::new(&cdf);
-    let mut rng = common::rng(16);
-    let mut mean_over_pdf = 0.0f64;
-    let n = 200_000;
-    for _ in 0..n {
-        let s = alias.sample_dir(Vec2::new(rng.random(), rng.random()));
-        assert!((envmap_sphere::latlong::latlong_uv_to_dir(s.uv) - s.dir).length() < 1e-5, "uv is the direction's");
-        assert_eq!(s.pdf, cdf.uv_pdf(s.uv), "the cdf distribution's pdf at {}", s.uv);
-        assert_eq!(s.pdf, alias.uv_pdf(s.uv));
-        mean_over_pdf += 1.0 / f64::from(s.pdf) / f64::from(n);
-    }
-    // E[1 / pdf] is the sphere's solid angle
-    assert!((mean_over_pdf / (4.0 * PI) - 1.0).abs() < 0.02, "E[1/pdf] = {mean_over_pdf}");
 }

@@ -13,7 +13,7 @@
 
 use crate::bvh::{SceneBvh, SurfacePoint};
 use crate::sampler::PixelSampler;
-use envmap_sphere::{EnvAliasDistribution, EnvDistribution, EnvMap, Sh9};
+use envmap_sphere::{EnvDistribution, EnvMap, Sh9};
 use glam::Vec3;
 use scene::DistantLight;
 use scene::brdf::Frame;
@@ -34,10 +34,12 @@ pub enum Strategy {
 pub struct EnvLight<'a> {
     /// The map.
     pub map: &'a EnvMap,
-    /// Its importance sampling distribution, in alias form: O(1) draws. An incomplete one
-    /// (MIS-compensated) is valid with BRDF samples ([`Strategy::Mis`], path tracing), not for
-    /// [`Strategy::EnvOnly`].
-    pub dist: EnvAliasDistribution,
+    /// Its importance sampling distribution. An incomplete one (MIS-compensated) is valid with
+    /// BRDF samples ([`Strategy::Mis`], path tracing), not for [`Strategy::EnvOnly`]. Drawn by
+    /// inverting its cdfs (a guide table makes that O(1) on average), which keeps the Sobol
+    /// sampler's stratification: an alias table, as fast here, scrambles it, and needed 1.3x /
+    /// 1.8x the samples for the same RMSE at 16 / 64 spp on `spheres_box`.
+    pub dist: EnvDistribution,
 }
 
 impl<'a> EnvLight<'a> {
@@ -46,14 +48,14 @@ impl<'a> EnvLight<'a> {
     /// the BRDF sample.
     #[must_use]
     pub fn new(map: &'a EnvMap) -> Self {
-        Self { map, dist: EnvAliasDistribution::new(&EnvDistribution::for_bilinear_compensated(map)) }
+        Self { map, dist: EnvDistribution::for_bilinear_compensated(map) }
     }
 
     /// The light with the complete distribution ([`EnvDistribution::for_bilinear`]: positive
     /// pdf wherever the map is), which map-only sampling needs.
     #[must_use]
     pub fn complete(map: &'a EnvMap) -> Self {
-        Self { map, dist: EnvAliasDistribution::new(&EnvDistribution::for_bilinear(map)) }
+        Self { map, dist: EnvDistribution::for_bilinear(map) }
     }
 
     /// The light `strategy` needs: complete for [`Strategy::EnvOnly`], compensated otherwise.
@@ -103,7 +105,7 @@ pub struct AmbientMap<'a> {
     /// The radiance.
     pub map: &'a EnvMap,
     /// Samples |radiance| (luminance), complete.
-    pub dist: EnvAliasDistribution,
+    pub dist: EnvDistribution,
     /// Pairs of a map sample and a BRDF sample per pixel sample ([`AmbientMap::SAMPLES`]).
     pub samples: u32,
 }
@@ -117,11 +119,7 @@ impl<'a> AmbientMap<'a> {
             return None;
         }
         let magnitude = EnvMap::from_texels(map.width(), map.height(), |i, j| map.pixel(i, j).abs());
-        Some(Self {
-            map,
-            dist: EnvAliasDistribution::new(&EnvDistribution::for_bilinear(&magnitude)),
-            samples: Self::SAMPLES,
-        })
+        Some(Self { map, dist: EnvDistribution::for_bilinear(&magnitude), samples: Self::SAMPLES })
     }
 
     /// Default pairs of samples per pixel sample: unshadowed, they cost map look-ups only.
