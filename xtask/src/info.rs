@@ -11,6 +11,9 @@ pub struct MapInfo {
     pub height: u32,
     pub format: &'static str,
     pub compression: String,
+    /// The file's primaries (red, green, blue, white xy) when its pixels were converted from
+    /// them to Rec.709; null otherwise.
+    pub converted_from_primaries: Option<[[f32; 2]; 4]>,
     pub max_luminance: f32,
     pub mean_luminance: f64,
     pub power: [f64; 3],
@@ -26,6 +29,7 @@ impl MapInfo {
             height: map.height(),
             format: report.format.name(),
             compression: report.compression.clone(),
+            converted_from_primaries: report.converted_from.map(|c| [c.red, c.green, c.blue, c.white]),
             max_luminance: stats.max,
             mean_luminance: stats.mean_per_pixel,
             power: map.power(),
@@ -39,6 +43,9 @@ impl MapInfo {
         outln!("{name}");
         outln!("  size          {} x {}", self.width, self.height);
         outln!("  format        {} ({})", self.format, self.compression);
+        if let Some([r, g, b, w]) = self.converted_from_primaries {
+            outln!("  primaries     converted to Rec.709 from R {r:?} G {g:?} B {b:?} white {w:?} (same CIE XYZ)");
+        }
         outln!(
             "  luminance     max {:.6}, mean {:.6} per pixel, {:.6} per sr",
             self.max_luminance,

@@ -20,13 +20,28 @@ fn info_json_has_the_documented_keys_and_values() {
     assert_eq!(text.trim().lines().count(), 1, "one JSON object on one line: {text}");
     let v: serde_json::Value = serde_json::from_str(&text).expect("valid JSON");
     let keys: Vec<&str> = v.as_object().expect("an object").keys().map(String::as_str).collect();
-    for k in ["width", "height", "format", "compression", "max_luminance", "mean_luminance", "power", "sh9"] {
+    for k in [
+        "width",
+        "height",
+        "format",
+        "compression",
+        "converted_from_primaries",
+        "max_luminance",
+        "mean_luminance",
+        "power",
+        "sh9",
+    ] {
         assert!(keys.contains(&k), "missing key {k} in {keys:?}");
     }
     assert_eq!((v["width"].as_u64(), v["height"].as_u64()), (Some(1024), Some(512)));
     assert_eq!((v["format"].as_str(), v["compression"].as_str()), (Some("exr"), Some("dwab")));
-    assert!((v["max_luminance"].as_f64().unwrap_or(0.0) - 31749.4).abs() < 1.0);
-    assert!((v["mean_luminance"].as_f64().unwrap_or(0.0) - 1.055).abs() < 0.01);
+    // city.exr declares sRGB primaries adapted to D50 (white at x 0.3457): read converted to
+    // Rec.709 of the same XYZ, its maximum luminance moves (stored values: 31749.4)
+    let white = &v["converted_from_primaries"][3];
+    assert!((white[0].as_f64().unwrap_or(0.0) - 0.3457).abs() < 1e-4, "{white}");
+    let (max, mean) = (v["max_luminance"].as_f64().unwrap_or(0.0), v["mean_luminance"].as_f64().unwrap_or(0.0));
+    assert!((max - 31839.6).abs() < 1.0, "{max}");
+    assert!((mean - 1.055).abs() < 0.01, "{mean}"); // XYZ is kept, so luminance barely moves
     let power = v["power"].as_array().expect("power array");
     assert_eq!(power.len(), 3);
     let sh9 = v["sh9"].as_array().expect("sh9 array");

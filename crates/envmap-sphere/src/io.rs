@@ -11,8 +11,13 @@
 //!   clamped to zero and the count and the fraction of power removed are reported, unless the
 //!   negative power exceeds [`DEFAULT_MAX_NEGATIVE_FRACTION`] of the positive power (a broken
 //!   file). [`NegativePolicy::Strict`] refuses any negative value; [`NegativePolicy::Keep`]
-//!   keeps them, for signed maps (a residual of light extraction).
+//!   keeps them, for signed maps (a residual of light extraction);
+//! - primaries: an EXR file whose `chromaticities` attribute is not Rec.709 (Blender's
+//!   `city.exr` declares sRGB primaries adapted to a D50 white) is converted to Rec.709 of the
+//!   same CIE XYZ, as OpenEXR and Mitsuba 3 read it ([`PrimariesPolicy`]). Radiance's
+//!   `PRIMARIES` line is ignored.
 
+use crate::color::Chromaticities;
 use crate::envmap::EnvMap;
 use crate::error::EnvMapError;
 use crate::tonemap::Tonemap;
@@ -52,6 +57,18 @@ pub enum NegativePolicy {
     Keep,
 }
 
+/// What to do with an EXR file's `chromaticities` attribute (its RGB primaries and white).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum PrimariesPolicy {
+    /// Convert pixels from the file's primaries to Rec.709 of the same CIE XYZ (as OpenEXR's
+    /// reference reader and Mitsuba 3 do), and report it in [`LoadReport::converted_from`].
+    #[default]
+    Convert,
+    /// Read the values as Rec.709 whatever the file says (as renderers that ignore the
+    /// attribute do).
+    Ignore,
+}
+
 impl Default for NegativePolicy {
     fn default() -> Self {
         Self::Clamp { max_power_fraction: DEFAULT_MAX_NEGATIVE_FRACTION }
@@ -67,6 +84,8 @@ pub struct LoadOptions {
     pub non_finite: NonFinitePolicy,
     /// Negative value handling.
     pub negative: NegativePolicy,
+    /// EXR primaries handling.
+    pub primaries: PrimariesPolicy,
 }
 
 impl Default for LoadOptions {
@@ -75,6 +94,7 @@ impl Default for LoadOptions {
             max_pixels: DEFAULT_MAX_PIXELS,
             non_finite: NonFinitePolicy::default(),
             negative: NegativePolicy::default(),
+            primaries: PrimariesPolicy::default(),
         }
     }
 }
@@ -107,6 +127,11 @@ pub struct LoadReport {
     /// Compression, lower case: "none", "rle", "zip", "zip16", "piz", "pxr24", "b44", "b44a",
     /// "dwaa", "dwab" for EXR; "rle" for Radiance (adaptive run-length).
     pub compression: String,
+    /// The primaries an EXR file declared (its `chromaticities` attribute) when they are not
+    /// Rec.709's: its pixels were converted to Rec.709 of the same CIE XYZ, without chromatic
+    /// adaptation ([`Chromaticities::to_rec709`], as OpenEXR and Mitsuba 3 convert). Saturated
+    /// colours may come out negative and then meet the negative policy.
+    pub converted_from: Option<Chromaticities>,
     /// Negative channel values clamped to zero.
     pub negatives_clamped: usize,
     /// Power removed by clamping, as a fraction of the positive power (sum over channels).
@@ -147,14 +172,16 @@ impl EnvMap {
         options: &LoadOptions,
     ) -> Result<(Self, LoadReport), EnvMapError> {
         let path = name.as_ref().to_path_buf();
-        let (width, height, mut pixels, format, compression) = decode(bytes, &path, options, true)?;
+        let Decoded { width, height, mut pixels, format, compression, converted_from, warnings } =
+            decode(bytes, &path, options, true)?;
         let mut report = LoadReport {
             format,
             compression,
+            converted_from,
             negatives_clamped: 0,
             negative_power_fraction: 0.0,
             non_finite_zeroed: 0,
-            warnings: Vec::new(),
+            warnings,
         };
         if width != 2 * height {
             report.warnings.push(format!(
@@ -248,7 +275,17 @@ pub fn encode_png_srgb8(width: u32, height: u32, bytes: &[u8]) -> Result<Vec<u8>
     Ok(png)
 }
 
-type Decoded = (u32, u32, Vec<Vec3>, FileFormat, String);
+/// A decoded file: pixels in linear Rec.709.
+struct Decoded {
+    width: u32,
+    height: u32,
+    pixels: Vec<Vec3>,
+    format: FileFormat,
+    compression: String,
+    /// The file's own primaries, when its pixels were converted from them.
+    converted_from: Option<Chromaticities>,
+    warnings: Vec<String>,
+}
 
 fn decode(bytes: &[u8], path: &Path, options: &LoadOptions, latlong: bool) -> Result<Decoded, EnvMapError> {
     if bytes.is_empty() {
@@ -282,7 +319,7 @@ pub fn load_rgb_image(path: impl AsRef<Path>) -> Result<RgbImage, EnvMapError> {
     let path = path.as_ref();
     let bytes = std::fs::read(path).map_err(|e| EnvMapError::io(path, e))?;
     let options = LoadOptions::default();
-    let (width, height, pixels, _, _) = decode(&bytes, path, &options, false)?;
+    let Decoded { width, height, pixels, .. } = decode(&bytes, path, &options, false)?;
     if let Some(k) = pixels.iter().position(|p| !p.is_finite()) {
         let count = pixels.iter().map(|p| p.to_array().iter().filter(|c| !c.is_finite()).count()).sum();
         return Err(EnvMapError::NonFinite {
@@ -337,11 +374,29 @@ fn decode_exr(bytes: &[u8], path: &Path, options: &LoadOptions, latlong: bool) -
         .all_attributes()
         .from_buffered(Cursor::new(bytes))
         .map_err(|e| err(e.to_string()))?;
-    let pixels = image.layer_data.channel_data.pixels;
+    let mut pixels = image.layer_data.channel_data.pixels;
     if pixels.len() != w as usize * h as usize {
         return Err(err(format!("decoded {} pixels for {w} x {h}", pixels.len())));
     }
-    Ok((w, h, pixels, FileFormat::Exr, compression))
+    let (mut converted_from, mut warnings) = (None, Vec::new());
+    if let Some(c) = header.shared_attributes.chromaticities.filter(|_| options.primaries == PrimariesPolicy::Convert) {
+        let v = |p: exr::math::Vec2<f32>| [p.x(), p.y()];
+        let file = Chromaticities { red: v(c.red), green: v(c.green), blue: v(c.blue), white: v(c.white) };
+        if !file.is_rec709() {
+            match file.to_rec709() {
+                Some(m) => {
+                    let m = m.as_mat3();
+                    pixels.iter_mut().for_each(|p| *p = m * *p);
+                    converted_from = Some(file);
+                }
+                None => warnings.push(format!(
+                    "{}: degenerate chromaticities {file:?} ignored: pixels read as Rec.709",
+                    path.display()
+                )),
+            }
+        }
+    }
+    Ok(Decoded { width: w, height: h, pixels, format: FileFormat::Exr, compression, converted_from, warnings })
 }
 
 fn decode_hdr(bytes: &[u8], path: &Path, options: &LoadOptions, latlong: bool) -> Result<Decoded, EnvMapError> {
@@ -359,7 +414,17 @@ fn decode_hdr(bytes: &[u8], path: &Path, options: &LoadOptions, latlong: bool) -
             Vec3::new(f(0), f(4), f(8))
         })
         .collect();
-    Ok((w, h, pixels, FileFormat::Hdr, "rle".into()))
+    // Radiance's PRIMARIES line is ignored, as Mitsuba 3 and most readers do (files in the wild
+    // often carry all zeros there).
+    Ok(Decoded {
+        width: w,
+        height: h,
+        pixels,
+        format: FileFormat::Hdr,
+        compression: "rle".into(),
+        converted_from: None,
+        warnings: Vec::new(),
+    })
 }
 
 /// Applies the non-finite and negative policies in place.

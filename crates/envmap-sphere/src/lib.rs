@@ -46,13 +46,15 @@ pub mod sat;
 pub mod sh;
 pub mod tonemap;
 
-pub use color::luminance;
+pub use color::{Chromaticities, luminance};
 pub use default::{DEFAULT_MAP_CREDIT, DEFAULT_MAP_NAME, default_map, default_map_bytes};
 pub use distribution::{DirSample, Distribution1D, EnvDistribution};
 pub use envmap::{EnvMap, texel_centre_dir};
 pub use error::EnvMapError;
 pub use integrate::LuminanceStats;
-pub use io::{FileFormat, LoadOptions, LoadReport, NegativePolicy, NonFinitePolicy, RgbImage, load_rgb_image};
+pub use io::{
+    FileFormat, LoadOptions, LoadReport, NegativePolicy, NonFinitePolicy, PrimariesPolicy, RgbImage, load_rgb_image,
+};
 pub use layout::{Layout, RadianceSource, SphereImage};
 pub use sat::SummedAreaTable;
 pub use sh::Sh9;

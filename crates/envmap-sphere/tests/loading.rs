@@ -2,8 +2,11 @@
 
 mod common;
 
-use envmap_sphere::{EnvMap, EnvMapError, FileFormat, LoadOptions, NegativePolicy, NonFinitePolicy, luminance};
-use glam::Vec3;
+use envmap_sphere::{
+    Chromaticities, EnvMap, EnvMapError, FileFormat, LoadOptions, NegativePolicy, NonFinitePolicy, PrimariesPolicy,
+    luminance,
+};
+use glam::{Mat3, Vec3};
 use std::path::Path;
 
 #[test]
@@ -23,9 +26,11 @@ fn every_shared_map_loads() {
         ("city.exr", 31749.0, 1.05),
     ];
     let maps = common::shared_maps();
+    // the README gives the files' own values: city.exr's primaries are not converted there
+    let as_stored = LoadOptions { primaries: PrimariesPolicy::Ignore, ..LoadOptions::default() };
     for (name, max, mean) in readme {
         let path = maps.iter().find(|p| p.ends_with(name)).unwrap_or_else(|| panic!("{name} missing"));
-        let (map, report) = EnvMap::load_with(path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+        let (map, report) = EnvMap::load_with(path, &as_stored).unwrap_or_else(|e| panic!("{e}"));
         assert_eq!((map.width(), map.height()), (1024, 512), "{name}");
         let stats = map.luminance_stats();
         // the README rounds to one decimal (city.exr to the unit)
@@ -42,10 +47,12 @@ fn every_shared_map_loads() {
 
 #[test]
 fn dwab_negative_ringing_is_clamped_and_reported() {
-    // Counts are channel values below zero, as the shared README gives them.
+    // Counts are channel values below zero, as the shared README gives them (of the values as
+    // stored: city.exr's primaries unconverted).
+    let as_stored = LoadOptions { primaries: PrimariesPolicy::Ignore, ..LoadOptions::default() };
     for (name, count) in [("city.exr", 506), ("courtyard.exr", 1818), ("studio.exr", 3)] {
         let path = common::envmaps_dir().join(name);
-        let (map, report) = EnvMap::load_with(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+        let (map, report) = EnvMap::load_with(&path, &as_stored).unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(report.negatives_clamped, count, "{name}");
         assert!(
             report.negative_power_fraction > 0.0 && report.negative_power_fraction < 1e-6,
@@ -53,10 +60,10 @@ fn dwab_negative_ringing_is_clamped_and_reported() {
             report.negative_power_fraction
         );
         assert!(map.pixels().iter().all(|p| p.min_element() >= 0.0));
-        let strict = LoadOptions { negative: NegativePolicy::Strict, ..LoadOptions::default() };
+        let strict = LoadOptions { negative: NegativePolicy::Strict, ..as_stored };
         let err = EnvMap::load_with(&path, &strict).expect_err("strict mode refuses negatives");
         assert!(matches!(err, EnvMapError::Negative { count: c, .. } if c == count), "{err}");
-        let keep = LoadOptions { negative: NegativePolicy::Keep, ..LoadOptions::default() };
+        let keep = LoadOptions { negative: NegativePolicy::Keep, ..as_stored };
         let (signed, report) = EnvMap::load_with(&path, &keep).unwrap_or_else(|e| panic!("{e}"));
         let kept = signed.pixels().iter().map(|p| p.to_array().iter().filter(|c| **c < 0.0).count()).sum::<usize>();
         assert_eq!((kept, report.negatives_clamped), (count, 0), "{name}: signed maps keep their values");
@@ -220,4 +227,102 @@ fn embedded_default_map_is_the_shared_city_map() {
     let shared = EnvMap::load(common::envmaps_dir().join("city.exr")).unwrap();
     assert_eq!(map, shared);
     assert!(luminance(map.pixels().iter().copied().fold(Vec3::ZERO, Vec3::max)) > 10_000.0);
+}
+
+/// An 8 x 4 RGB EXR file of `rgb` everywhere, declaring `chromaticities` if given.
+fn exr_with_primaries(path: &Path, rgb: impl Fn(usize) -> Vec3 + Sync, chromaticities: Option<Chromaticities>) {
+    use exr::prelude::*;
+    let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
+        let c = rgb(p.y() * 8 + p.x());
+        (c.x, c.y, c.z)
+    });
+    let mut image = Image::from_channels((8, 4), channels);
+    image.attributes.chromaticities = chromaticities.map(|c| {
+        let v = |[x, y]: [f32; 2]| Vec2(x, y);
+        exr::meta::attribute::Chromaticities { red: v(c.red), green: v(c.green), blue: v(c.blue), white: v(c.white) }
+    });
+    image.write().to_file(path).unwrap();
+}
+
+/// sRGB primaries adapted to a D50 white, as Blender's `city.exr` declares them.
+const SRGB_D50: Chromaticities = Chromaticities {
+    red: [0.648_447_4, 0.330_876_6],
+    green: [0.321_187_1, 0.597_894_3],
+    blue: [0.155_901_4, 0.066_056_3],
+    white: [0.345_708_4, 0.358_541_3],
+};
+
+#[test]
+fn exr_primaries_are_converted_to_rec709_of_the_same_xyz() {
+    let dir = common::scratch_dir("primaries");
+    let colour =
+        |k: usize| Vec3::new(0.2 + 0.1 * (k % 5) as f32, 0.3 + 0.05 * (k % 7) as f32, 0.1 + 0.2 * (k % 3) as f32);
+    // Published matrices, independent of the code under test: linear sRGB / Rec.709 (IEC
+    // 61966-2-1) and Adobe RGB (1998), RGB -> XYZ.
+    let rec709_to_xyz =
+        Mat3::from_cols_array(&[0.4124, 0.2126, 0.0193, 0.3576, 0.7152, 0.1192, 0.1805, 0.0722, 0.9505]);
+    let adobe_to_xyz = Mat3::from_cols_array(&[
+        0.576_67, 0.297_34, 0.027_03, 0.185_56, 0.627_36, 0.070_69, 0.188_23, 0.075_29, 0.991_34,
+    ]);
+    let adobe = Chromaticities { red: [0.64, 0.33], green: [0.21, 0.71], blue: [0.15, 0.06], white: [0.3127, 0.3290] };
+    let path = dir.join("adobe.exr");
+    exr_with_primaries(&path, colour, Some(adobe));
+    let (map, report) = EnvMap::load_with(&path, &LoadOptions::default()).unwrap();
+    assert_eq!(report.converted_from, Some(adobe));
+    for (k, p) in map.pixels().iter().enumerate() {
+        let (want, got) = (adobe_to_xyz * colour(k), rec709_to_xyz * *p);
+        assert!((want - got).abs().max_element() < 1e-3, "texel {k}: XYZ {got} vs {want}");
+    }
+    // No chromatic adaptation: the D50 white of city.exr's primaries stays D50 (XYZ 0.9642, 1,
+    // 0.8249) and reads warm in Rec.709: the standard XYZ -> sRGB matrix gives these values.
+    let path = dir.join("d50.exr");
+    exr_with_primaries(&path, |_| Vec3::ONE, Some(SRGB_D50));
+    let (map, _) = EnvMap::load_with(&path, &LoadOptions::default()).unwrap();
+    let want = Vec3::new(1.1762, 0.9758, 0.7216);
+    assert!(map.pixels().iter().all(|p| (*p - want).abs().max_element() < 2e-3), "{}", map.pixel(0, 0));
+    // Rec.709 declared, nothing declared, or the attribute ignored: the values as stored.
+    let ignore = LoadOptions { primaries: PrimariesPolicy::Ignore, ..LoadOptions::default() };
+    for (name, declared, options) in [
+        ("709.exr", Some(Chromaticities::REC709), LoadOptions::default()),
+        ("none.exr", None, LoadOptions::default()),
+        ("ignored.exr", Some(adobe), ignore),
+    ] {
+        let path = dir.join(name);
+        exr_with_primaries(&path, colour, declared);
+        let (map, report) = EnvMap::load_with(&path, &options).unwrap();
+        assert_eq!(report.converted_from, None, "{name}");
+        assert!(map.pixels().iter().enumerate().all(|(k, p)| *p == colour(k)), "{name}");
+    }
+    // Degenerate primaries (a zero y, collinear): read as Rec.709, with a warning naming the file.
+    for (k, bad) in [
+        Chromaticities { red: [0.64, 0.0], ..adobe },
+        Chromaticities { red: [0.2, 0.2], green: [0.3, 0.3], blue: [0.4, 0.4], white: [0.3127, 0.3290] },
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let path = dir.join(format!("bad{k}.exr"));
+        exr_with_primaries(&path, colour, Some(bad));
+        let (map, report) = EnvMap::load_with(&path, &LoadOptions::default()).unwrap();
+        assert_eq!(report.converted_from, None);
+        assert!(report.warnings.iter().any(|w| w.contains("degenerate") && w.contains(&path.display().to_string())));
+        assert!(map.pixels().iter().enumerate().all(|(k, p)| *p == colour(k)));
+    }
+}
+
+#[test]
+fn city_exr_is_read_from_its_d50_primaries() {
+    // Blender's city.exr declares sRGB primaries adapted to D50: read as Mitsuba 3 reads it, its
+    // grey sky turns warm (about 1.18, 0.98, 0.72 of the stored values).
+    let path = common::envmaps_dir().join("city.exr");
+    let (map, report) = EnvMap::load_with(&path, &LoadOptions::default()).unwrap();
+    let stored = LoadOptions { primaries: PrimariesPolicy::Ignore, ..LoadOptions::default() };
+    let (raw, _) = EnvMap::load_with(&path, &stored).unwrap();
+    let c = report.converted_from.expect("city.exr declares its primaries");
+    let near = |a: [f32; 2], b: [f32; 2]| (a[0] - b[0]).abs() < 1e-5 && (a[1] - b[1]).abs() < 1e-5;
+    assert!(near(c.red, SRGB_D50.red) && near(c.white, SRGB_D50.white), "{c:?}");
+    let sum = |m: &EnvMap| m.pixels().iter().fold(Vec3::ZERO, |a, p| a + *p);
+    let ratio = sum(&map) / sum(&raw);
+    assert!((ratio - Vec3::new(1.176, 0.976, 0.722)).abs().max_element() < 0.02, "{ratio}");
+    assert_eq!(envmap_sphere::default_map(), map, "the embedded copy reads the same");
 }
