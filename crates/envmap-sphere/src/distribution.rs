@@ -172,8 +172,9 @@ impl EnvDistribution {
     /// "MIS Compensation: Optimizing Sampling Techniques in Multiple Importance Sampling"): each
     /// weight minus the weights' mean over the sphere, clamped at zero. Map samples then go to
     /// what stands out of the map, and the smooth rest is left to the BRDF sample that MIS
-    /// combines them with, which samples it better; on the bundled maps that lowers the
-    /// error of `env-direct` renders at equal samples by 15-57 %.
+    /// combines them with, which samples it better: `env-direct` on `spheres_box` at 16 spp
+    /// (Sobol points) has 0.92x the RMSE on `venice_sunset_1k.hdr`, 0.88x on `studio.exr`,
+    /// about the same on `city.exr`.
     ///
     /// The pdf is *incomplete*: zero wherever the map is at or below its mean, so an estimator
     /// that samples only this distribution misses that light. Use it only in MIS with a
@@ -322,7 +323,7 @@ fn bilinear_weights(map: &EnvMap) -> Vec<f64> {
 }
 
 /// The point (s, t) in [0, 1)^2 of texel (i, j), uniform in phi and cos theta (`row_cos` holds
-/// each row's cos theta bounds), as a [`DirSample`] with the given pdf. Shared by both samplers.
+/// each row's cos theta bounds), as a [`DirSample`] with the given pdf.
 #[inline]
 pub(crate) fn texel_point(
     [width, height]: [usize; 2],

@@ -345,7 +345,9 @@ fn specular_ambient(bvh: &SceneBvh, sh: &Shading, a: &AmbientMap, shadow: bool, 
         if let Some((wi, pdf)) = sh.material.sample_brdf(sh.wo, s.next_2d(), s.next_1d()) {
             let dir = sh.frame.to_world(wi);
             if sh.f_cos(dir).0 != Vec3::ZERO {
-                let t = term(wi, a.map.lookup(dir), pdf, a.dist.dir_pdf(dir));
+                // one direction -> lat-long conversion for both the radiance and the pdf
+                let uv = envmap_sphere::latlong::latlong_dir_to_uv(dir);
+                let t = term(wi, a.map.lookup_uv(uv), pdf, a.dist.uv_pdf(uv));
                 l += arriving(bvh, sh, dir, Vec3::ZERO, t, shadow);
             }
         }
