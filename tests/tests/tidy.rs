@@ -50,3 +50,23 @@ fn every_crate_shares_the_workspace_lints() {
         assert!(text.contains("[lints]\nworkspace = true"), "{} does not use [workspace.lints]", m.display());
     }
 }
+
+#[test]
+fn nothing_reads_beside_the_repository() {
+    // A user's clone has nothing beside it: data lives in the repository (assets/). Built from
+    // parts so this file does not trip its own check.
+    let beside = concat!("..", "/shared");
+    let root = workspace_root();
+    let mut files = rust_sources();
+    for (dir, ext) in [(".", "toml"), ("crates", "toml"), ("xtask", "toml"), (".ci", "run"), ("shaders", "wgsl")] {
+        workspace_tests::collect(&root.join(dir), ext, &mut files);
+    }
+    files.push(root.join(".ci/run"));
+    files.push(root.join(".cargo/config.toml"));
+    let hits: Vec<String> = files
+        .iter()
+        .filter(|p| std::fs::read_to_string(p).is_ok_and(|t| t.contains(beside)))
+        .map(|p| p.display().to_string())
+        .collect();
+    assert!(hits.is_empty(), "files that read {beside}:\n{}", hits.join("\n"));
+}

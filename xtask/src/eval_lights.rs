@@ -9,7 +9,7 @@ use light_extract::{EmissiveSplit, LightExtractor};
 use ref_tracer::metrics::{FlipTonemap, flip, rmse};
 use ref_tracer::{AmbientMap, EnvLight, Integrator, LightSet, RenderSettings, SceneBvh, Strategy};
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 pub struct EvalArgs {
     pub maps: PathBuf,
@@ -51,8 +51,8 @@ fn chosen_methods(k: usize, only: &[String]) -> Result<Vec<Method>, String> {
 
 /// (label, extractor): Table 1's methods, then Table 2's ablation of EmissiveSplit, then our
 /// options (not the papers'): above-horizon (only the hemisphere above the ground reaches the
-/// receivers), moment cones, and the residual as the remainder (median cut's too, for a fair
-/// comparison).
+/// receivers), moment cones, the residual as the remainder (median cut's too, for a fair
+/// comparison), and a light for every compact source of visible shadow (weber).
 fn methods(k: usize) -> Vec<Method> {
     let es = EmissiveSplit { lights: k, ..EmissiveSplit::default() };
     let ablations: [(&str, Box<dyn LightExtractor>); 3] = [
@@ -71,6 +71,8 @@ fn methods(k: usize) -> Vec<Method> {
                 "emissive-split+moment-cones",
                 "emissive-split+moment-cones+above-horizon",
                 "emissive-split+moment-cones+above-horizon+residual",
+                "emissive-split+weber",
+                "emissive-split+moment-cones+weber+above-horizon+residual",
                 "median-cut+above-horizon",
                 "median-cut+above-horizon+residual",
             ]
@@ -81,13 +83,7 @@ fn methods(k: usize) -> Vec<Method> {
 }
 
 pub fn run(args: &EvalArgs) -> Result<(), String> {
-    let mut maps: Vec<PathBuf> = std::fs::read_dir(&args.maps)
-        .map_err(|e| format!("{}: {e}", args.maps.display()))?
-        .flatten()
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|x| x == "exr" || x == "hdr"))
-        .collect();
-    maps.sort();
+    let maps = envmap_sphere::test_set::maps_in(&args.maps)?;
     if maps.is_empty() {
         return Err(format!("{}: no .exr or .hdr maps", args.maps.display()));
     }
@@ -287,7 +283,7 @@ fn write_tables(rows: &[Row], args: &EvalArgs) -> Result<(), String> {
     Ok(())
 }
 
-/// `../shared/envmaps` beside the workspace.
+/// The repository's test maps (`assets/envmaps`, or `ENVSHADOW_ENVMAPS`).
 pub fn default_maps_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/envmaps")
+    envmap_sphere::test_set::dir()
 }

@@ -1,8 +1,8 @@
-//! Makes sure Mesa's lavapipe (software Vulkan) is installed: GPU code is validated on it.
-//!
-//! Installs `mesa-vulkan-drivers` with apt when it is missing and we run as root; otherwise
-//! stops with the exact command to run.
+//! The GPU a command runs on: the best adapter present, or the one `--adapter` names. Only on a
+//! machine with no adapter at all is Mesa's lavapipe (software Vulkan) installed — with apt, when
+//! we run as root — or asked for with the exact command to run.
 
+use gpu::{Gpu, GpuError};
 use std::path::Path;
 use std::process::Command;
 
@@ -45,4 +45,41 @@ pub fn ensure() -> Result<(), String> {
         return Err(format!("installing lavapipe failed ({status}); run `{INSTALL}` by hand"));
     }
     Ok(())
+}
+
+/// The GPU for a command: `adapter` (`--adapter`), else `ENVSHADOW_ADAPTER`, else the best
+/// adapter present. Lavapipe is installed (or asked for) only when there is no adapter at all.
+pub fn open_gpu(adapter: Option<&str>) -> Result<Gpu, String> {
+    let open = || match adapter {
+        Some(name) => Gpu::with_adapter(Some(name)),
+        None => Gpu::new(),
+    };
+    match open() {
+        Err(GpuError::NoAdapter(_)) => {
+            outln!("no GPU adapter found: using Mesa's lavapipe (software Vulkan)");
+            ensure()?;
+            open().map_err(|e| e.to_string())
+        }
+        other => other.map_err(|e| e.to_string()),
+    }
+}
+
+/// Makes sure some adapter exists before GPU tests run: installs lavapipe only when there is none,
+/// and checks that `adapter`, when given, names one. Returns the one the tests will use,
+/// described.
+pub fn ensure_adapter(adapter: Option<&str>) -> Result<String, String> {
+    if gpu::adapters(None).is_empty() {
+        outln!("no GPU adapter found: using Mesa's lavapipe (software Vulkan)");
+        ensure()?;
+    }
+    let infos = gpu::adapters(None);
+    let wanted = adapter.map(str::to_string).or_else(|| std::env::var(gpu::ADAPTER_ENV).ok().filter(|n| !n.is_empty()));
+    match gpu::pick_adapter(&infos, wanted.as_deref()) {
+        Some(k) => Ok(gpu::describe_adapter(&infos[k])),
+        None => Err(GpuError::UnknownAdapter {
+            wanted: wanted.unwrap_or_default(),
+            found: infos.iter().map(gpu::describe_adapter).collect(),
+        }
+        .to_string()),
+    }
 }

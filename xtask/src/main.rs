@@ -13,6 +13,7 @@ macro_rules! outln {
 
 mod eval_lights;
 mod extract;
+mod fuzz;
 mod info;
 mod lavapipe;
 mod render;
@@ -21,6 +22,10 @@ mod test;
 mod validate;
 
 use clap::{Parser, Subcommand};
+
+/// The allocator with accounts: `fuzz` limits each case's memory and reports the peak.
+#[global_allocator]
+static ALLOCATOR: cap::Cap<std::alloc::System> = cap::Cap::new(std::alloc::System, usize::MAX);
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -38,8 +43,13 @@ enum Command {
     /// and write target/validate/report.html. Fails when an error exceeds
     /// validate/thresholds.json.
     Validate(validate::ValidateArgs),
-    /// Run the test suite (installs lavapipe first where it is missing and we are root).
+    /// Run the test suite, the GPU tests on the best adapter present (lavapipe is installed
+    /// first only where there is no adapter at all and we are root).
     Test {
+        /// The GPU adapter for the GPU tests and validate: a case-insensitive part of its name,
+        /// or `cpu` for a software one.
+        #[arg(long)]
+        adapter: Option<String>,
         /// Extra arguments passed to `cargo test` (after `--`).
         #[arg(last = true)]
         args: Vec<String>,
@@ -80,7 +90,7 @@ enum Command {
     /// Every extraction method against the env-direct truth over maps x scenes: Markdown and CSV
     /// tables under target/eval-lights (paper 001's Table 1).
     EvalLights {
-        /// Folder of maps; ../shared/envmaps when absent.
+        /// Folder of maps; the repository's test set (assets/envmaps) when absent.
         #[arg(long)]
         maps: Option<PathBuf>,
         /// Comma-separated built-in scenes.
@@ -113,6 +123,17 @@ enum Command {
         /// Test image of the same size.
         test: PathBuf,
     },
+    /// Structured fuzzing of every file a command reads (.hdr, .exr, lights.json,
+    /// thresholds): mutations of small valid files; prints the findings and last
+    /// `fuzz: N cases, P panics, ...`; exits 1 when anything was found.
+    Fuzz {
+        /// Number of cases.
+        #[arg(long, default_value_t = 1_000_000)]
+        cases: usize,
+        /// Seed of the mutations.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
     /// Print an environment map's size, format, luminance, power and SH9 coefficients.
     Info {
         /// The map (.exr or .hdr).
@@ -131,8 +152,9 @@ pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
+        Command::Fuzz { cases, seed } => return fuzz::run(cases, seed),
         Command::Validate(args) => validate::run(&args),
-        Command::Test { args } => test::run(&args),
+        Command::Test { adapter, args } => test::run(adapter.as_deref(), &args),
         Command::Info { path, json } => info::run(&path, json),
         Command::Scene { name, obj } => scene::run(&name, &obj),
         Command::Render(args) => render::run(&args),

@@ -4,10 +4,10 @@
 use crate::parse_size;
 use envmap_sphere::{EnvMap, LoadOptions, NegativePolicy, Sh9, Tonemap};
 use glam::Vec3;
+use light_extract::output::{LightsFile, read_lights_json};
 use ref_tracer::metrics::{FlipTonemap, flip, rmse};
 use ref_tracer::{AmbientMap, EnvLight, Integrator, LightSet, RenderSettings, SamplerKind, SceneBvh, Strategy};
 use scene::{DistantLight, Scene};
-use serde::Deserialize;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
@@ -71,13 +71,6 @@ pub fn load_map(path: Option<&Path>) -> Result<EnvMap, String> {
     }
 }
 
-#[derive(Deserialize)]
-struct LightsFile {
-    lights: Vec<LightEntry>,
-    #[serde(default)]
-    interleaved: Vec<Vec<LightEntry>>,
-}
-
 /// What a `lights.json` holds for rendering.
 pub struct LightsData {
     pub lights: Vec<DistantLight>,
@@ -87,45 +80,11 @@ pub struct LightsData {
     pub ambient_map: Option<EnvMap>,
 }
 
-#[derive(Deserialize)]
-struct LightEntry {
-    direction: [f32; 3],
-    solid_angle: f32,
-    radiance: [f32; 3],
-}
-
-fn parse_lights(path: &Path, entries: &[LightEntry]) -> Result<Vec<DistantLight>, String> {
-    entries
-        .iter()
-        .enumerate()
-        .map(|(k, l)| {
-            let d = Vec3::from_array(l.direction);
-            let r = Vec3::from_array(l.radiance);
-            let ok = d.is_finite()
-                && d.length() > 0.0
-                && l.solid_angle > 0.0
-                && l.solid_angle <= 4.0 * std::f32::consts::PI
-                && r.is_finite()
-                && r.min_element() >= 0.0;
-            if !ok {
-                return Err(format!(
-                    "{}: light {k} is invalid (direction must be non-zero, solid_angle in (0, 4 pi], radiance finite and non-negative)",
-                    path.display()
-                ));
-            }
-            Ok(DistantLight { direction: d.normalize(), solid_angle: l.solid_angle, radiance: r })
-        })
-        .collect()
-}
-
 /// Lights from a `lights.json` (the light-extract schema; `lights[]` and `interleaved[][]` with
 /// their `direction`, `solid_angle` and `radiance` are read) and, when an `ambient.exr` sits
 /// beside it, that map and its SH9.
 pub fn load_lights(path: &Path) -> Result<LightsData, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let file: LightsFile = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
-    let lights = parse_lights(path, &file.lights)?;
-    let interleaved = file.interleaved.iter().map(|set| parse_lights(path, set)).collect::<Result<_, _>>()?;
+    let LightsFile { lights, interleaved } = read_lights_json(path).map_err(|e| e.to_string())?;
     let ambient_path = path.with_file_name("ambient.exr");
     // signed when it is a residual (`+residual`): negative values are data, not ringing
     let signed = LoadOptions { negative: NegativePolicy::Keep, ..LoadOptions::default() };

@@ -1,15 +1,16 @@
 //! `cargo xtask test`: the whole test suite, as CI runs it.
 //!
-//! Unit, integration and doc tests of every crate (the GPU ones on lavapipe where there is no
-//! GPU), one smoke run of every criterion bench (so benches never rot), and — when no test
+//! Unit, integration and doc tests of every crate (the GPU ones on the best adapter present, or
+//! the one `--adapter` names; lavapipe where there is no GPU), one smoke run of every criterion bench (so benches never rot), and — when no test
 //! filter is given — the main job, `cargo xtask validate --quick`, with its thresholds. Prints
 //! the wall time.
 
 use std::process::Command;
 use std::time::Instant;
 
-pub fn run(extra: &[String]) -> Result<(), String> {
-    crate::lavapipe::ensure()?;
+pub fn run(adapter: Option<&str>, extra: &[String]) -> Result<(), String> {
+    let chosen = crate::lavapipe::ensure_adapter(adapter)?;
+    outln!("xtask test: GPU tests on {chosen}");
     let start = Instant::now();
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     // --all-targets covers libs, bins, tests and benches (criterion runs each bench once under
@@ -18,6 +19,9 @@ pub fn run(extra: &[String]) -> Result<(), String> {
     for args in runs {
         let mut cmd = Command::new(&cargo);
         cmd.args(args);
+        if let Some(name) = adapter {
+            cmd.env(gpu::ADAPTER_ENV, name);
+        }
         if !extra.is_empty() {
             cmd.arg("--").args(extra);
         }
@@ -28,9 +32,12 @@ pub fn run(extra: &[String]) -> Result<(), String> {
         }
     }
     if extra.is_empty() {
-        outln!("xtask test: cargo xtask validate --quick");
+        outln!("xtask test: cargo xtask validate --check-readme README.md");
         // the command's own defaults, as a user gets them
-        crate::validate::run(&clap::Parser::parse_from(["validate", "--quick"]))?;
+        // the main job with its defaults, as a user runs it, and the README's figures with it
+        let mut validate = vec!["validate", "--check-readme", "README.md"];
+        validate.extend(adapter.map(|a| ["--adapter", a]).into_iter().flatten());
+        crate::validate::run(&clap::Parser::parse_from(validate))?;
     }
     outln!("xtask test: all passed in {:.0} s", start.elapsed().as_secs_f64());
     Ok(())

@@ -8,7 +8,7 @@ fn xtask(args: &[&str]) -> Output {
 }
 
 fn shared(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/envmaps").join(name)
+    envmap_sphere::test_set::path(name)
 }
 
 #[test]
@@ -83,12 +83,24 @@ fn bad_input_exits_one_with_one_line_naming_the_file() {
 }
 
 #[test]
-fn validate_quick_writes_a_self_contained_report_and_meets_its_thresholds() {
+fn validate_quick_runs_from_a_copied_binary_and_meets_its_thresholds() {
+    // a binary copied elsewhere, run from an empty folder: the thresholds are in the binary
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli-validate");
-    let out = xtask(&["validate", "--quick", "--out", dir.to_str().unwrap_or_default()]);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let copy = dir.join("xtask-copy");
+    std::fs::copy(env!("CARGO_BIN_EXE_xtask"), &copy).expect("copy the binary");
+    let out =
+        Command::new(&copy).args(["validate", "--quick", "--out", "out"]).current_dir(&dir).output().expect("run");
+    let dir = dir.join("out");
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{text}\n{}", String::from_utf8_lossy(&out.stderr));
     assert!(text.contains("[1/8] load environment map") && text.contains("[8/8] report"), "{text}");
+    // the adapter is named before any work, and again by the GPU stage
+    let first = text.lines().next().unwrap_or_default();
+    let adapter = first.strip_prefix("GPU: ").unwrap_or_else(|| panic!("first line {first:?}"));
+    let name = adapter.split(" (").next().unwrap_or_default();
+    assert!(text.lines().any(|l| l.contains("[5/8] GPU") && l.contains(name)), "{text}");
     assert!(text.contains("thresholds met") && !text.contains(" 0 thresholds met"), "{text}");
     let html = std::fs::read_to_string(dir.join("report.html")).expect("report written");
     assert!(html.contains("data:image/png;base64,") && !html.contains("src=\"http"), "images embedded");
@@ -96,6 +108,51 @@ fn validate_quick_writes_a_self_contained_report_and_meets_its_thresholds() {
     {
         assert!(html.contains(row), "report lacks {row}");
     }
+}
+
+#[test]
+fn an_unknown_adapter_exits_one_with_one_line_listing_the_adapters() {
+    let out = xtask(&["validate", "--quick", "--adapter", "no-such-gpu-xyz"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(err.contains("no-such-gpu-xyz") && err.contains("found:"), "{err}");
+    assert!(out.stdout.is_empty(), "no work before the adapter is settled: {}", String::from_utf8_lossy(&out.stdout));
+}
+
+#[test]
+fn validate_reads_thresholds_from_a_file_and_refuses_a_broken_one() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli-thresholds");
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    for (name, text, want) in [
+        ("missing.json", None, "missing.json"),
+        ("broken.json", Some("{\"thresholds\": {\"a\": \"x\"}}"), "threshold a is not a finite number"),
+        ("empty.json", Some("[]"), "no \"thresholds\" object"),
+    ] {
+        let path = dir.join(name);
+        match text {
+            Some(t) => std::fs::write(&path, t).expect("write"),
+            None => {
+                let _ = std::fs::remove_file(&path);
+            }
+        }
+        let out = xtask(&["validate", "--quick", "--thresholds", path.to_str().unwrap_or_default()]);
+        assert_eq!(out.status.code(), Some(1), "{name}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(err.contains(name) && err.contains(want), "{err}");
+    }
+}
+
+#[test]
+fn fuzz_short_run_finds_nothing() {
+    let out = xtask(&["fuzz", "--cases", "5000", "--seed", "7"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}\n{}", String::from_utf8_lossy(&out.stderr));
+    let last = text.trim().lines().last().unwrap_or_default();
+    assert!(last.starts_with("fuzz: 5000 cases, 0 panics, 0 errors not one line naming the file"), "{last}");
+    // every target ran, and some cases were refused and some loaded
+    assert!(text.contains("thresholds.json") && text.contains("lights.json") && text.contains("map.exr"), "{text}");
 }
 
 #[test]
@@ -291,7 +348,7 @@ fn eval_lights_writes_both_tables_with_a_noise_floor() {
     let csv = std::fs::read_to_string(out_dir.join("eval-lights.csv")).expect("csv");
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines[0], "map,scene,method,lights,rmse,converged_rmse,flip,extract_ms");
-    assert_eq!(lines.len(), 1 + 15, "floor + five methods + three ablations + six of our options: {csv}");
+    assert_eq!(lines.len(), 1 + 17, "floor + five methods + three ablations + eight of our options: {csv}");
     for ablation in ["emissive-split/no-masking", "emissive-split/no-kmeans", "emissive-split/neither"] {
         assert!(csv.contains(&format!(",{ablation},")), "{ablation} missing:\n{csv}");
     }
@@ -306,6 +363,8 @@ fn eval_lights_writes_both_tables_with_a_noise_floor() {
         "emissive-split+moment-cones",
         "emissive-split+moment-cones+above-horizon",
         "emissive-split+moment-cones+above-horizon+residual",
+        "emissive-split+weber",
+        "emissive-split+moment-cones+weber+above-horizon+residual",
         "median-cut+above-horizon",
         "median-cut+above-horizon+residual",
     ] {

@@ -124,3 +124,14 @@ impl EnvMapError {
 
 /// Path used in errors about maps that never came from a file.
 pub const MEMORY_PATH: &str = "<memory>";
+
+/// `text` on one line: line breaks, tabs and other control characters escaped as Rust writes
+/// them (`\n`), so a decoder's reason or a name read from a file cannot break an error message
+/// across lines.
+#[must_use]
+pub fn one_line(text: &str) -> String {
+    if !text.chars().any(char::is_control) {
+        return text.to_string();
+    }
+    text.chars().map(|c| if c.is_control() { c.escape_default().to_string() } else { c.to_string() }).collect()
+}

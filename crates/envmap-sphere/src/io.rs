@@ -19,7 +19,7 @@
 
 use crate::color::Chromaticities;
 use crate::envmap::EnvMap;
-use crate::error::EnvMapError;
+use crate::error::{EnvMapError, one_line};
 use crate::tonemap::Tonemap;
 use glam::Vec3;
 use std::io::Cursor;
@@ -318,8 +318,21 @@ pub struct RgbImage {
 pub fn load_rgb_image(path: impl AsRef<Path>) -> Result<RgbImage, EnvMapError> {
     let path = path.as_ref();
     let bytes = std::fs::read(path).map_err(|e| EnvMapError::io(path, e))?;
-    let options = LoadOptions::default();
-    let Decoded { width, height, pixels, .. } = decode(&bytes, path, &options, false)?;
+    load_rgb_image_from_bytes(&bytes, path, &LoadOptions::default())
+}
+
+/// [`load_rgb_image`] from the bytes of a file; `name` is used in errors, and only
+/// `options.max_pixels` applies.
+///
+/// # Errors
+/// As [`load_rgb_image`].
+pub fn load_rgb_image_from_bytes(
+    bytes: &[u8],
+    name: impl AsRef<Path>,
+    options: &LoadOptions,
+) -> Result<RgbImage, EnvMapError> {
+    let path = name.as_ref();
+    let Decoded { width, height, pixels, .. } = decode(bytes, path, options, false)?;
     if let Some(k) = pixels.iter().position(|p| !p.is_finite()) {
         let count = pixels.iter().map(|p| p.to_array().iter().filter(|c| !c.is_finite()).count()).sum();
         return Err(EnvMapError::NonFinite {
@@ -348,17 +361,28 @@ fn check_size(path: &Path, w: u64, h: u64, options: &LoadOptions, latlong: bool)
 
 fn decode_exr(bytes: &[u8], path: &Path, options: &LoadOptions, latlong: bool) -> Result<Decoded, EnvMapError> {
     use exr::prelude::*;
-    let err = |reason: String| EnvMapError::Decode { path: path.to_path_buf(), format: "OpenEXR", reason };
+    let err =
+        |reason: String| EnvMapError::Decode { path: path.to_path_buf(), format: "OpenEXR", reason: one_line(&reason) };
     let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false).map_err(|e| err(e.to_string()))?;
     let header = meta.headers.first().ok_or_else(|| err("no layers".into()))?;
     let size = header.layer_size;
     let (w, h) = check_size(path, size.width() as u64, size.height() as u64, options, latlong)?;
+    // every chunk has an 8-byte entry in the offset table: a file shorter than the table cannot
+    // hold the pixels its header claims (refused before the pixel buffer is allocated)
+    let table = meta.headers.iter().map(|h| h.chunk_count as u64).sum::<u64>().saturating_mul(8);
+    if (bytes.len() as u64) < table {
+        return Err(err(format!(
+            "truncated: its {table}-byte chunk offset table alone is longer than the file ({} bytes)",
+            bytes.len()
+        )));
+    }
+    check_dwa_chunks(bytes, &meta).map_err(err)?;
     let compression = format!("{:?}", header.compression);
     let compression = compression.split('(').next().unwrap_or("").to_lowercase();
     let compression = if compression == "uncompressed" { "none".to_string() } else { compression };
     let has = |name: &str| header.channels.list.iter().any(|c| c.name.eq(name));
     if !(has("R") && has("G") && has("B")) {
-        let names: Vec<String> = header.channels.list.iter().map(|c| c.name.to_string()).collect();
+        let names: Vec<String> = header.channels.list.iter().map(|c| format!("{:?}", c.name.to_string())).collect();
         return Err(err(format!("no R, G, B channels (has {})", names.join(", "))));
     }
     let image = read()
@@ -399,21 +423,83 @@ fn decode_exr(bytes: &[u8], path: &Path, options: &LoadOptions, latlong: bool) -
     Ok(Decoded { width: w, height: h, pixels, format: FileFormat::Exr, compression, converted_from, warnings })
 }
 
+/// DWAA / DWAB chunks whose leading counters claim more values than their block can hold are
+/// refused here: the `exr` crate (1.74.2) reserves memory by those counters before checking
+/// them, and aborts the process on an absurd one (found by `cargo xtask fuzz`).
+fn check_dwa_chunks(bytes: &[u8], meta: &exr::meta::MetaData) -> Result<(), String> {
+    use exr::compression::Compression;
+    use exr::meta::BlockDescription;
+    if !meta.headers.iter().any(|h| matches!(h.compression, Compression::DWAA(_) | Compression::DWAB(_))) {
+        return Ok(());
+    }
+    // where the offset tables start: right after the headers
+    let mut cursor = Cursor::new(bytes);
+    if exr::meta::MetaData::read_from_buffered(&mut cursor, false).is_err() {
+        return Ok(()); // the decoder says why
+    }
+    let multipart = meta.requirements.is_multilayer();
+    let table_start = usize::try_from(cursor.position()).unwrap_or(usize::MAX);
+    let u64_at =
+        |at: usize| bytes.get(at..at.checked_add(8)?).map(|b| u64::from_le_bytes(b.try_into().unwrap_or([0; 8])));
+    let i32_at =
+        |at: usize| bytes.get(at..at.checked_add(4)?).map(|b| i32::from_le_bytes(b.try_into().unwrap_or([0; 4])));
+    let mut entry = table_start;
+    for (part, header) in meta.headers.iter().enumerate() {
+        // values a block can hold: its pixels times the channels, with room for rounding
+        let block_pixels = match header.blocks {
+            BlockDescription::ScanLines => header.layer_size.width() * header.compression.scan_lines_per_block(),
+            BlockDescription::Tiles(t) => t.tile_size.width() * t.tile_size.height(),
+        };
+        let limit =
+            (block_pixels.saturating_mul(header.channels.list.len()) as u64).saturating_mul(2).saturating_add(64);
+        for chunk in 0..header.chunk_count {
+            let Some(offset) = u64_at(entry) else { return Ok(()) };
+            entry += 8;
+            let Ok(mut at) = usize::try_from(offset) else { continue };
+            if multipart {
+                at = at.saturating_add(4);
+            }
+            at = at.saturating_add(match header.blocks {
+                BlockDescription::ScanLines => 4,
+                BlockDescription::Tiles(_) => 16,
+            });
+            let Some(size) = i32_at(at) else { continue };
+            let data = at.saturating_add(4);
+            if size < 88 || !matches!(header.compression, Compression::DWAA(_) | Compression::DWAB(_)) {
+                continue;
+            }
+            // counters 1..=9 after the version: sizes in bytes, then the AC and DC counts
+            for k in 1..10 {
+                let Some(v) = u64_at(data + 8 * k) else { break };
+                let bound = if k >= 8 { limit } else { limit.saturating_mul(8) };
+                if v > bound {
+                    return Err(format!(
+                        "part {part}, chunk {chunk}: a DWA counter claims {v}, more than its block of {block_pixels} pixels can hold"
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 fn decode_hdr(bytes: &[u8], path: &Path, options: &LoadOptions, latlong: bool) -> Result<Decoded, EnvMapError> {
     use image::ImageDecoder;
-    let err = |reason: String| EnvMapError::Decode { path: path.to_path_buf(), format: "Radiance HDR", reason };
+    let err = |reason: String| EnvMapError::Decode {
+        path: path.to_path_buf(),
+        format: "Radiance HDR",
+        reason: one_line(&reason),
+    };
     let decoder = image::codecs::hdr::HdrDecoder::new(Cursor::new(bytes)).map_err(|e| err(e.to_string()))?;
     let (w, h) = decoder.dimensions();
     let (w, h) = check_size(path, u64::from(w), u64::from(h), options, latlong)?;
-    let mut buf = vec![0u8; decoder.total_bytes() as usize];
-    decoder.read_image(&mut buf).map_err(|e| err(e.to_string()))?;
-    let pixels = buf
-        .chunks_exact(12)
-        .map(|c| {
-            let f = |k: usize| f32::from_ne_bytes([c[k], c[k + 1], c[k + 2], c[k + 3]]);
-            Vec3::new(f(0), f(4), f(8))
-        })
-        .collect();
+    // decoded straight into the pixels (f32 RGB in native byte order): one buffer, not two
+    let mut pixels = vec![Vec3::ZERO; w as usize * h as usize];
+    let buf: &mut [u8] = bytemuck::cast_slice_mut(&mut pixels);
+    if buf.len() as u64 != decoder.total_bytes() {
+        return Err(err(format!("decoder wants {} bytes for {w} x {h} RGB f32", decoder.total_bytes())));
+    }
+    decoder.read_image(buf).map_err(|e| err(e.to_string()))?;
     // Radiance's PRIMARIES line is ignored, as Mitsuba 3 and most readers do (files in the wild
     // often carry all zeros there).
     Ok(Decoded {
@@ -437,9 +523,9 @@ fn sanitize(
     report: &mut LoadReport,
 ) -> Result<(), EnvMapError> {
     let path: PathBuf = path.to_path_buf();
-    let non_finite: Vec<usize> = pixels.iter().enumerate().filter(|(_, p)| !p.is_finite()).map(|(k, _)| k).collect();
-    if let Some(&first) = non_finite.first() {
-        let count: usize = non_finite.iter().map(|&k| (0..3).filter(|&c| !pixels[k][c].is_finite()).count()).sum();
+    // counted, not collected: a broken file may be all NaN
+    if let Some(first) = pixels.iter().position(|p| !p.is_finite()) {
+        let count: usize = pixels[first..].iter().map(|p| p.to_array().iter().filter(|c| !c.is_finite()).count()).sum();
         match options.non_finite {
             NonFinitePolicy::Error => {
                 return Err(EnvMapError::NonFinite {
@@ -450,8 +536,7 @@ fn sanitize(
                 });
             }
             NonFinitePolicy::Zero => {
-                for &k in &non_finite {
-                    let p = &mut pixels[k];
+                for p in pixels[first..].iter_mut().filter(|p| !p.is_finite()) {
                     *p = Vec3::from_array(p.to_array().map(|c| if c.is_finite() { c } else { 0.0 }));
                 }
                 report.non_finite_zeroed = count;

@@ -11,7 +11,7 @@ use std::path::Path;
 
 #[test]
 fn every_shared_map_loads() {
-    // (file, max luminance, mean luminance) from ../shared/envmaps/README.md
+    // (file, max luminance, mean luminance) from assets/envmaps/README.md
     let readme = [
         ("adams_place_bridge_1k.hdr", 110.7, 1.30),
         ("empty_warehouse_01_1k.hdr", 400.3, 0.65),
@@ -47,7 +47,7 @@ fn every_shared_map_loads() {
 
 #[test]
 fn dwab_negative_ringing_is_clamped_and_reported() {
-    // Counts are channel values below zero, as the shared README gives them (of the values as
+    // Counts are channel values below zero, as the test set's README gives them (of the values as
     // stored: city.exr's primaries unconverted).
     let as_stored = LoadOptions { primaries: PrimariesPolicy::Ignore, ..LoadOptions::default() };
     for (name, count) in [("city.exr", 506), ("courtyard.exr", 1818), ("studio.exr", 3)] {

@@ -1,11 +1,21 @@
-//! Device creation: the adapter wgpu picks (llvmpipe on these machines), with the optional
-//! features our passes use when the adapter has them.
+//! Device creation on the best adapter present (a discrete GPU, then an integrated one, then a
+//! virtual one, then a CPU implementation such as Mesa's lavapipe), or on one named by the
+//! caller or by `ENVSHADOW_ADAPTER`, with the optional features our passes use when the adapter
+//! has them.
 
 use std::time::{Duration, Instant};
 
 /// Errors of the GPU layer.
 #[derive(Debug, thiserror::Error)]
 pub enum GpuError {
+    /// No adapter matches the name asked for.
+    #[error("no GPU adapter matches {wanted:?}; found: {}", if found.is_empty() { "none".to_string() } else { found.join("; ") })]
+    UnknownAdapter {
+        /// The name asked for (a substring of an adapter's name, or `cpu`).
+        wanted: String,
+        /// The adapters found, described.
+        found: Vec<String>,
+    },
     /// No adapter at all.
     #[error(
         "no GPU adapter found: install Mesa's software Vulkan driver (Debian/Ubuntu: \
@@ -49,28 +59,122 @@ pub struct Gpu {
     pub limits: wgpu::Limits,
 }
 
+/// The environment variable [`Gpu::new`] reads an adapter name from (as `--adapter`).
+pub const ADAPTER_ENV: &str = "ENVSHADOW_ADAPTER";
+
+/// Preference of a device type: discrete first, CPU implementations last.
+fn type_rank(t: wgpu::DeviceType) -> u8 {
+    match t {
+        wgpu::DeviceType::DiscreteGpu => 0,
+        wgpu::DeviceType::IntegratedGpu => 1,
+        wgpu::DeviceType::VirtualGpu => 2,
+        wgpu::DeviceType::Other => 3,
+        wgpu::DeviceType::Cpu => 4,
+    }
+}
+
+/// Preference of a backend: the one our passes are validated on first.
+fn backend_rank(b: wgpu::Backend) -> u8 {
+    match b {
+        wgpu::Backend::Vulkan => 0,
+        wgpu::Backend::Metal => 1,
+        wgpu::Backend::Dx12 => 2,
+        wgpu::Backend::Gl => 3,
+        _ => 4,
+    }
+}
+
+/// One line for an adapter: name, backend, type, driver.
+#[must_use]
+pub fn describe_adapter(info: &wgpu::AdapterInfo) -> String {
+    let driver = format!("{} {}", info.driver, info.driver_info);
+    let driver = driver.trim();
+    if driver.is_empty() {
+        format!("{} ({:?}, {:?})", info.name, info.backend, info.device_type)
+    } else {
+        format!("{} ({:?}, {:?}; driver {driver})", info.name, info.backend, info.device_type)
+    }
+}
+
+/// Index of the adapter `wanted` picks among `infos`: the best by type, then backend, when
+/// `wanted` is `None`, OpenGL adapters last (our passes need more than GLSL offers); else the best whose name contains `wanted` (case-insensitive), or the
+/// best CPU implementation for `cpu`.
+#[must_use]
+pub fn pick_adapter(infos: &[wgpu::AdapterInfo], wanted: Option<&str>) -> Option<usize> {
+    let wanted = wanted.map(str::to_lowercase);
+    infos
+        .iter()
+        .enumerate()
+        .filter(|(_, i)| match wanted.as_deref() {
+            None => true,
+            Some("cpu") => i.device_type == wgpu::DeviceType::Cpu,
+            Some(w) => i.name.to_lowercase().contains(w),
+        })
+        // OpenGL lacks what our passes need (depth textureLoad): any other backend first
+        .min_by_key(|(k, i)| (i.backend == wgpu::Backend::Gl, type_rank(i.device_type), backend_rank(i.backend), *k))
+        .map(|(k, _)| k)
+}
+
+/// Every adapter on `backends` (`None`: `WGPU_BACKEND`, else the primary backends — Vulkan,
+/// Metal, DX12 — since our passes need more than OpenGL offers), and those backends.
+fn enumerate(backends: Option<wgpu::Backends>) -> (Vec<wgpu::Adapter>, wgpu::Backends) {
+    let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+    descriptor.backends = backends.or_else(wgpu::Backends::from_env).unwrap_or(wgpu::Backends::PRIMARY);
+    let backends = descriptor.backends;
+    let instance = wgpu::Instance::new(descriptor);
+    (pollster::block_on(instance.enumerate_adapters(backends)), backends)
+}
+
+/// Every adapter present on `backends` (`None`: `WGPU_BACKEND`, else Vulkan, Metal and DX12).
+#[must_use]
+pub fn adapters(backends: Option<wgpu::Backends>) -> Vec<wgpu::AdapterInfo> {
+    enumerate(backends).0.iter().map(wgpu::Adapter::get_info).collect()
+}
+
 impl Gpu {
-    /// Creates a device on the default adapter, enabling `CLIP_DISTANCES` and timestamp queries
-    /// when the adapter has them.
+    /// Creates a device on the adapter named by `ENVSHADOW_ADAPTER` when it is set (see
+    /// [`Gpu::with_adapter`]), else on the best adapter present, enabling `CLIP_DISTANCES` and
+    /// timestamp queries when the adapter has them.
     ///
     /// # Errors
-    /// [`GpuError::NoAdapter`] naming `mesa-vulkan-drivers` when there is no adapter.
+    /// [`GpuError::NoAdapter`] naming `mesa-vulkan-drivers` when there is no adapter,
+    /// [`GpuError::UnknownAdapter`] when none matches `ENVSHADOW_ADAPTER`.
     pub fn new() -> Result<Self, GpuError> {
-        Self::with_backends(None)
+        let named = std::env::var(ADAPTER_ENV).ok().filter(|n| !n.is_empty());
+        Self::open(None, named.as_deref())
     }
 
-    /// As [`Gpu::new`], restricted to `backends` (`None`: wgpu's default, or `WGPU_BACKEND`).
+    /// Creates a device on the adapter `wanted` names (a case-insensitive substring of its
+    /// name, or `cpu` for a CPU implementation such as lavapipe), or on the best adapter present
+    /// when `None`: discrete, integrated, virtual, other, CPU, in that order, Vulkan first and
+    /// OpenGL (only through `WGPU_BACKEND`) only when there is nothing else.
+    ///
+    /// # Errors
+    /// [`GpuError::NoAdapter`] when there is none at all, [`GpuError::UnknownAdapter`] (listing
+    /// those found) when none matches.
+    pub fn with_adapter(wanted: Option<&str>) -> Result<Self, GpuError> {
+        Self::open(None, wanted)
+    }
+
+    /// The best adapter on `backends` (`None`: `WGPU_BACKEND`, else Vulkan, Metal and DX12).
     ///
     /// # Errors
     /// [`GpuError::NoAdapter`] when none of them has an adapter.
     pub fn with_backends(backends: Option<wgpu::Backends>) -> Result<Self, GpuError> {
-        let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
-        if let Some(b) = backends {
-            descriptor.backends = b;
+        Self::open(backends, None)
+    }
+
+    fn open(backends: Option<wgpu::Backends>, wanted: Option<&str>) -> Result<Self, GpuError> {
+        let (all, backends) = enumerate(backends);
+        let infos: Vec<wgpu::AdapterInfo> = all.iter().map(wgpu::Adapter::get_info).collect();
+        if infos.is_empty() {
+            return Err(GpuError::NoAdapter(format!("no adapter on backends {backends:?}")));
         }
-        let instance = wgpu::Instance::new(descriptor);
-        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions::default()))
-            .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
+        let k = pick_adapter(&infos, wanted).ok_or_else(|| GpuError::UnknownAdapter {
+            wanted: wanted.unwrap_or_default().to_string(),
+            found: infos.iter().map(describe_adapter).collect(),
+        })?;
+        let adapter = &all[k];
         let info = adapter.get_info();
         let wanted = wgpu::Features::CLIP_DISTANCES
             | wgpu::Features::TIMESTAMP_QUERY
@@ -90,10 +194,7 @@ impl Gpu {
     /// One line: adapter, backend, driver and its version.
     #[must_use]
     pub fn describe(&self) -> String {
-        format!(
-            "{} ({:?}, {:?}; driver {} {})",
-            self.info.name, self.info.backend, self.info.device_type, self.info.driver, self.info.driver_info
-        )
+        describe_adapter(&self.info)
     }
 
     /// Whether vertex shaders can write clip distances (`CLIP_DISTANCES`).

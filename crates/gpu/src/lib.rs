@@ -21,7 +21,7 @@ pub mod shader;
 mod target;
 mod timer;
 
-pub use context::{Gpu, GpuError};
+pub use context::{ADAPTER_ENV, Gpu, GpuError, adapters, describe_adapter, pick_adapter};
 pub use gbuffer::{GBUFFER_FORMAT, GBuffer, GBufferPass, view_projection};
 pub use geometry::{Chunk, SceneGeometry, ShadowGeometry, scene_triangles};
 pub use readback::{read_texture_f32, read_texture_rgba};

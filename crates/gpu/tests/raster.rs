@@ -170,3 +170,56 @@ fn adapter_is_described_and_sizes_beyond_the_limits_are_refused() {
     let err = Visibility::new(&gpu, too_big, 4, 1).err().expect("refused");
     assert!(err.to_string().contains("exceeds the adapter's limit"), "{err}");
 }
+
+fn adapter(name: &str, device_type: wgpu::DeviceType, backend: wgpu::Backend) -> wgpu::AdapterInfo {
+    wgpu::AdapterInfo { name: name.into(), ..wgpu::AdapterInfo::new(device_type, backend) }
+}
+
+#[test]
+fn the_best_adapter_is_a_real_gpu_and_lavapipe_the_fallback() {
+    use wgpu::{Backend, DeviceType};
+    let lavapipe = adapter("llvmpipe (LLVM 15.0.6, 256 bits)", DeviceType::Cpu, Backend::Vulkan);
+    let lavapipe_gl = adapter("llvmpipe (LLVM 15.0.6, 256 bits)", DeviceType::Cpu, Backend::Gl);
+    let h200_gl = adapter("NVIDIA H200", DeviceType::DiscreteGpu, Backend::Gl);
+    let h200 = adapter("NVIDIA H200", DeviceType::DiscreteGpu, Backend::Vulkan);
+    let intel = adapter("Intel(R) UHD Graphics 770", DeviceType::IntegratedGpu, Backend::Vulkan);
+    let infos = [lavapipe_gl, lavapipe, intel, h200_gl, h200];
+    // discrete first, and on it the backend our passes are validated on
+    assert_eq!(gpu::pick_adapter(&infos, None), Some(4));
+    assert_eq!(gpu::pick_adapter(&infos[..3], None), Some(2), "integrated before CPU");
+    assert_eq!(gpu::pick_adapter(&infos[..2], None), Some(1), "lavapipe on Vulkan before GL");
+    let gl_only = [infos[3].clone(), infos[0].clone(), infos[1].clone()];
+    assert_eq!(gpu::pick_adapter(&gl_only, None), Some(2), "OpenGL only when there is nothing else");
+    assert_eq!(gpu::pick_adapter(&gl_only[..2], None), Some(0));
+    let other_gl = adapter("llvmpipe", DeviceType::Other, Backend::Gl);
+    assert_eq!(gpu::pick_adapter(&[other_gl, infos[1].clone()], None), Some(1));
+    assert_eq!(gpu::pick_adapter(&infos, Some("cpu")), Some(1));
+    assert_eq!(gpu::pick_adapter(&infos, Some("CPU")), Some(1), "names are case-insensitive");
+    assert_eq!(gpu::pick_adapter(&infos, Some("intel")), Some(2));
+    assert_eq!(gpu::pick_adapter(&infos, Some("h200")), Some(4));
+    assert_eq!(gpu::pick_adapter(&infos, Some("llvmpipe")), Some(1));
+    assert_eq!(gpu::pick_adapter(&infos, Some("radeon")), None);
+    assert_eq!(gpu::pick_adapter(&[], None), None);
+}
+
+#[test]
+fn an_unknown_adapter_name_is_one_line_listing_the_adapters_found() {
+    let err = Gpu::with_adapter(Some("no-such-adapter-xyz")).err().expect("no adapter has that name");
+    let text = err.to_string();
+    assert!(!text.contains('\n'), "{text}");
+    assert!(text.contains("no-such-adapter-xyz") && text.contains("found:"), "{text}");
+    // every adapter present is listed by name
+    for info in gpu::adapters(None) {
+        assert!(text.contains(&info.name), "{} missing from {text}", info.name);
+    }
+}
+
+#[test]
+fn the_software_adapter_is_named_cpu() {
+    // CI has lavapipe; elsewhere a machine may have only hardware adapters
+    let has_cpu = gpu::adapters(None).iter().any(|i| i.device_type == wgpu::DeviceType::Cpu);
+    match Gpu::with_adapter(Some("cpu")) {
+        Ok(g) => assert_eq!(g.info.device_type, wgpu::DeviceType::Cpu, "{}", g.describe()),
+        Err(e) => assert!(!has_cpu, "{e}"),
+    }
+}

@@ -12,12 +12,14 @@
 //! is an interval of phi, found in closed form (whole rows near a pole, wrapping at the seam), and
 //! summed with per-row prefix sums, so a cap costs one step per row it crosses. Each filter size
 //! is evaluated on the pyramid level (exact solid-angle box downsampling) where its inner cap spans
-//! about 8 rows, at that level's brightest 10 % of texels. Extraction itself is at full
+//! about 8 rows, at that level's brightest 10 % of texels (exactly 10 %: ties, as on a flat
+//! background, are broken by a hash of the position, so the cost does not depend on them). Extraction itself is at full
 //! resolution.
 
 use crate::decomposition::{Decomposition, ExtractError, ExtractedLight, LightExtractor};
 use envmap_sphere::{EnvMap, luminance};
 use glam::{DVec3, Vec3};
+use rayon::prelude::*;
 use scene::DistantLight;
 use std::f64::consts::PI;
 use std::time::Instant;
@@ -69,20 +71,47 @@ struct CapSums {
 }
 
 impl CapSums {
-    fn new(map: &EnvMap) -> Self {
-        let (w, h) = (map.width() as usize, map.height() as usize);
-        let mut prefix = Vec::with_capacity((w + 1) * h);
-        for j in 0..h {
-            let sa = map.texel_solid_angle(j as u32);
+    /// The sums of the level that merges `f` x `f` texels of a full-resolution map whose texels
+    /// hold luminance x solid angle in `energy` (`w` x `h`, both multiples of `f`).
+    fn level(energy: &[f64], w: usize, h: usize, f: usize) -> Self {
+        let (lw, lh) = (w / f, h / f);
+        let rows = (0..lh).map(|j| (PI * (j as f64 + 0.5) / lh as f64).sin_cos()).collect();
+        let mut sums = Self { w: lw, h: lh, prefix: vec![0.0; (lw + 1) * lh], rows };
+        sums.update_rows(energy, w, f, 0..=lh - 1);
+        sums
+    }
+
+    /// Recomputes the level's rows `rows` from the full-resolution `energy`.
+    fn update_rows(&mut self, energy: &[f64], w: usize, f: usize, rows: std::ops::RangeInclusive<usize>) {
+        for j in rows {
+            let row = &mut self.prefix[j * (self.w + 1)..(j + 1) * (self.w + 1)];
             let mut acc = 0.0;
-            prefix.push(0.0);
-            for p in map.row(j as u32) {
-                acc += f64::from(luminance(*p).max(0.0)) * sa;
-                prefix.push(acc);
+            row[0] = 0.0;
+            if f == 1 {
+                for (i, e) in energy[j * w..(j + 1) * w].iter().enumerate() {
+                    acc += e;
+                    row[i + 1] = acc;
+                }
+                continue;
+            }
+            for i in 0..self.w {
+                for y in j * f..(j + 1) * f {
+                    acc += energy[y * w + i * f..y * w + (i + 1) * f].iter().sum::<f64>();
+                }
+                row[i + 1] = acc;
             }
         }
-        let rows = (0..h).map(|j| (PI * (j as f64 + 0.5) / h as f64).sin_cos()).collect();
-        Self { w, h, prefix, rows }
+    }
+
+    /// Mean luminance of each texel of the level (energy over solid angle).
+    fn luminance(&self) -> Vec<f32> {
+        let mut out = Vec::with_capacity(self.w * self.h);
+        for j in 0..self.h {
+            let sa = envmap_sphere::latlong::latlong_texel_solid_angle(j as u32, self.w as u32, self.h as u32);
+            let row = &self.prefix[j * (self.w + 1)..(j + 1) * (self.w + 1)];
+            out.extend(row.windows(2).map(|p| ((p[1] - p[0]) / sa) as f32));
+        }
+        out
     }
 
     /// Sum over columns [a, b] (inclusive, a <= b, may exceed the row and wrap) of row j.
@@ -171,6 +200,22 @@ fn inner_cap(map: &EnvMap, theta: f64, phi: f64, r: f64) -> (Vec<(u32, u32)>, DV
     (texels, power, centroid)
 }
 
+/// The indices of the brightest `fraction` of the positive texels of `lum`: exactly
+/// ceil(fraction x count) of them, however many tie (a flat background would otherwise make every
+/// texel a candidate). Ties are broken by a hash of the index, so tied candidates spread evenly
+/// over the map instead of piling up in its first rows.
+fn brightest(lum: &[f32], fraction: f64) -> Vec<usize> {
+    let n = ((lum.len() as f64 * fraction).ceil() as usize).clamp(1, lum.len());
+    let mut idx: Vec<usize> = (0..lum.len()).filter(|&k| lum[k] >= f32::MIN_POSITIVE).collect();
+    if idx.len() > n {
+        let spread = |k: usize| (k as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15).rotate_left(29);
+        idx.select_nth_unstable_by(n - 1, |&a, &b| lum[b].total_cmp(&lum[a]).then(spread(a).cmp(&spread(b))));
+        idx.truncate(n);
+        idx.sort_unstable();
+    }
+    idx
+}
+
 /// (theta, phi) of texel (i, j)'s centre.
 fn angles(i: usize, j: usize, w: usize, h: usize) -> (f64, f64) {
     (PI * (j as f64 + 0.5) / h as f64, 2.0 * PI * (i as f64 + 0.5) / w as f64)
@@ -230,8 +275,10 @@ impl CenterSurround {
     }
 }
 
-/// One pyramid level: its map, cap sums and candidate centres.
+/// One pyramid level: its cap sums and candidate centres.
 struct Level {
+    /// texels merged per side
+    factor: usize,
     sums: CapSums,
     /// candidate texel centres (theta, phi), fixed at the first iteration
     candidates: Vec<(f64, f64)>,
@@ -243,13 +290,27 @@ struct Response {
     value: f64,
     theta: f64,
     phi: f64,
+    /// unit direction of (theta, phi)
+    dir: DVec3,
     ro: f64,
     level: usize,
 }
 
-fn angle_between(a: (f64, f64), b: (f64, f64)) -> f64 {
-    let dir = |(t, p): (f64, f64)| DVec3::new(t.sin() * p.sin(), t.cos(), -t.sin() * p.cos());
-    dir(a).dot(dir(b)).clamp(-1.0, 1.0).acos()
+/// Unit direction of (theta, phi) in the toolkit's convention.
+fn dir_of(theta: f64, phi: f64) -> DVec3 {
+    DVec3::new(theta.sin() * phi.sin(), theta.cos(), -theta.sin() * phi.cos())
+}
+
+/// Luminance x solid angle of each texel of `map` (negatives as zero).
+fn texel_energy(map: &EnvMap) -> Vec<f64> {
+    let w = map.width() as usize;
+    let mut out = Vec::with_capacity(map.pixels().len());
+    for j in 0..map.height() {
+        let sa = map.texel_solid_angle(j);
+        out.extend(map.row(j).iter().map(|p| f64::from(luminance(*p).max(0.0)) * sa));
+    }
+    debug_assert_eq!(out.len(), w * map.height() as usize);
+    out
 }
 
 impl CenterSurround {
@@ -259,38 +320,19 @@ impl CenterSurround {
         (self.inner_weight * inner + self.ring_weight * (outer - inner)) / (2.0 * ro)
     }
 
-    /// The pyramid of `map` for `plan`: one downsampled map per level.
-    fn pyramid(map: &EnvMap, plan: &[(u32, Vec<f64>)]) -> Vec<EnvMap> {
-        let mut out = Vec::with_capacity(plan.len());
-        let (mut current, mut at) = (map.clone(), 0);
-        for (level, _) in plan {
-            while at < *level {
-                current = current.resize(current.width() / 2, current.height() / 2);
-                at += 1;
-            }
-            out.push(current.clone());
-        }
-        out
-    }
-
-    /// The levels of `map` for `plan`; candidates: each level's brightest fraction of texels.
-    fn levels(&self, map: &EnvMap, plan: &[(u32, Vec<f64>)]) -> Vec<Level> {
-        Self::pyramid(map, plan)
-            .into_iter()
-            .map(|current| {
-                let (w, h) = (current.width() as usize, current.height() as usize);
-                let lum: Vec<f32> = current.pixels().iter().map(|p| luminance(*p)).collect();
-                let n = ((lum.len() as f64 * self.candidate_fraction).ceil() as usize).clamp(1, lum.len());
-                let mut sorted = lum.clone();
-                sorted.select_nth_unstable_by(lum.len() - n, f32::total_cmp);
-                let threshold = sorted[lum.len() - n].max(f32::MIN_POSITIVE);
-                let candidates = lum
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, y)| **y >= threshold)
-                    .map(|(k, _)| angles(k % w, k / w, w, h))
+    /// The levels of `plan` over the full-resolution `energy`; candidates: each level's
+    /// brightest fraction of texels.
+    fn levels(&self, energy: &[f64], w: usize, h: usize, plan: &[(u32, Vec<f64>)]) -> Vec<Level> {
+        plan.iter()
+            .map(|(level, _)| {
+                let factor = 1usize << level;
+                let sums = CapSums::level(energy, w, h, factor);
+                let (lw, lh) = (sums.w, sums.h);
+                let candidates = brightest(&sums.luminance(), self.candidate_fraction)
+                    .into_iter()
+                    .map(|k| angles(k % lw, k / lw, lw, lh))
                     .collect();
-                Level { sums: CapSums::new(&current), candidates }
+                Level { factor, sums, candidates }
             })
             .collect()
     }
@@ -313,15 +355,23 @@ impl LightExtractor for CenterSurround {
         let mut lights: Vec<ExtractedLight> = Vec::new();
         let mut found = 0.0f64;
         let plan = self.plan(map);
-        let mut levels = self.levels(&remainder, &plan);
+        let (w, h) = (map.width() as usize, map.height() as usize);
+        let mut energy = texel_energy(&remainder);
+        let mut levels = self.levels(&energy, w, h, &plan);
+        // each response is computed on its own: the same values on any number of threads
         let mut responses: Vec<Response> = Vec::new();
         for (li, (level, (_, radii))) in levels.iter().zip(&plan).enumerate() {
-            for &(theta, phi) in &level.candidates {
-                for &ro in radii {
-                    let value = self.response(&level.sums, theta, phi, ro);
-                    responses.push(Response { value, theta, phi, ro, level: li });
-                }
-            }
+            let found: Vec<Response> = level
+                .candidates
+                .par_iter()
+                .flat_map_iter(|&(theta, phi)| {
+                    radii.iter().map(move |&ro| {
+                        let value = self.response(&level.sums, theta, phi, ro);
+                        Response { value, theta, phi, dir: dir_of(theta, phi), ro, level: li }
+                    })
+                })
+                .collect();
+            responses.extend(found);
         }
         while lights.len() < self.max_lights {
             let Some(best) =
@@ -346,20 +396,26 @@ impl LightExtractor for CenterSurround {
             }
             for &(i, j) in &texels {
                 remainder.set_pixel(i, j, Vec3::ZERO);
+                energy[j as usize * w + i as usize] = 0.0;
             }
-            // Only filters overlapping the removed cap change: refresh those, on updated levels.
-            for (level, map) in levels.iter_mut().zip(Self::pyramid(&remainder, &plan)) {
-                level.sums = CapSums::new(&map);
+            // Only the rows the cap crossed change, and only filters overlapping it: refresh
+            // those rows of each level, then those filters.
+            let (j0, j1) =
+                texels.iter().fold((usize::MAX, 0), |(a, b), &(_, j)| (a.min(j as usize), b.max(j as usize)));
+            for level in &mut levels {
+                let f = level.factor;
+                level.sums.update_rows(&energy, w, f, j0 / f..=j1 / f);
             }
-            for r in responses.iter_mut() {
-                if angle_between((r.theta, r.phi), (theta, phi)) <= r.ro + ri + 2.0 * PI / levels[r.level].sums.h as f64
-                {
+            let centre = dir_of(theta, phi);
+            responses.par_iter_mut().for_each(|r| {
+                let reach = r.ro + ri + 2.0 * PI / levels[r.level].sums.h as f64;
+                if reach >= PI || r.dir.dot(centre) >= reach.cos() {
                     r.value = self.response(&levels[r.level].sums, r.theta, r.phi, r.ro);
                 }
-            }
+            });
             found += intensity;
             let solid_angle = 2.0 * PI * (1.0 - cos_r);
-            let direction = DVec3::new(theta.sin() * phi.sin(), theta.cos(), -theta.sin() * phi.cos()).as_vec3();
+            let direction = centre.as_vec3();
             lights.push(ExtractedLight {
                 light: DistantLight {
                     direction: direction.normalize(),
@@ -379,5 +435,29 @@ impl LightExtractor for CenterSurround {
         let mut d = Decomposition::new("center-surround", params, map, lights, remainder, true);
         d.time_ms = start.elapsed().as_secs_f64() * 1e3;
         Ok(d)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::brightest;
+
+    #[test]
+    fn candidates_are_the_fraction_asked_for_whatever_the_ties() {
+        let flat = vec![1.0f32; 100_000];
+        let c = brightest(&flat, 0.1);
+        assert_eq!(c.len(), 10_000);
+        // ties spread over the whole map, not piled up in its first rows
+        assert!(c.iter().filter(|&&k| k < 50_000).count().abs_diff(5_000) < 500);
+        // strictly brighter texels always win over ties
+        let mut lum = flat.clone();
+        lum[99_999] = 2.0;
+        lum[12_345] = 3.0;
+        let c = brightest(&lum, 0.1);
+        assert!(c.contains(&99_999) && c.contains(&12_345) && c.len() == 10_000);
+        // black texels are never candidates
+        assert!(brightest(&vec![0.0f32; 1000], 0.1).is_empty());
+        let half: Vec<f32> = (0..1000).map(|k| if k % 2 == 0 { 1.0 } else { 0.0 }).collect();
+        assert!(brightest(&half, 1.0).iter().all(|k| k % 2 == 0));
     }
 }

@@ -17,7 +17,9 @@
 //! [`AboveHorizon`] wraps any of them (our option, not a paper's): for scenes on an opaque
 //! ground it models only the hemisphere that can reach the receivers. [`Residual`] (ours too)
 //! keeps any method's lights for the shadows and makes the remainder the signed residual, map
-//! minus lights, so glossy surfaces reflect the map's detail the cones average away.
+//! minus lights, so glossy surfaces reflect the map's detail the cones average away. [`Weber`]
+//! (ours) gives every compact source whose shadow would be visible (over 2 % of some receiver's
+//! irradiance) a light of its own, within the budget.
 //!
 //! Outputs: [`Decomposition::to_json`] (`lights.json`), [`Decomposition::to_gltf`] (glTF 2.0 with
 //! `KHR_lights_punctual` directional lights), the remainder map (`ambient.exr`) and an overlay of
@@ -44,6 +46,7 @@ pub mod overlay;
 mod regions;
 mod residual;
 mod variance;
+mod weber;
 
 pub use above_horizon::{AboveHorizon, narrow_to_horizon, upper_hemisphere};
 pub use center_surround::CenterSurround;
@@ -55,17 +58,19 @@ pub use importance::ImportanceSampled;
 pub use median_cut::MedianCut;
 pub use residual::{Residual, splat_lights};
 pub use variance::VarianceMinimization;
+pub use weber::{COVERED_SHARE, CompactSource, Weber, compact_sources};
 
 /// The methods by name, as `lights.json` and the commands name them.
 pub const METHODS: [&str; 5] = ["emissive-split", "center-surround", "median-cut", "variance-min", "importance"];
 
 /// Our options (not the papers'), appended to a method's name with `+`: `moment-cones`
-/// (emissive split only, [`EmissiveSplit::moment_cones`]), then `above-horizon` (any method,
-/// [`AboveHorizon`]), then `residual` (any method, [`Residual`]).
-pub const OPTIONS: [&str; 3] = ["moment-cones", "above-horizon", "residual"];
+/// (emissive split only, [`EmissiveSplit::moment_cones`]), then `weber` (any method,
+/// [`Weber`]), then `above-horizon` (any method, [`AboveHorizon`]), then `residual` (any
+/// method, [`Residual`]).
+pub const OPTIONS: [&str; 4] = ["moment-cones", "weber", "above-horizon", "residual"];
 
 /// The extractor named `method` (one of [`METHODS`], optionally followed by [`OPTIONS`] in that
-/// order, e.g. `emissive-split+moment-cones+above-horizon+residual`) with a budget of `k` lights and the
+/// order, e.g. `emissive-split+moment-cones+weber+above-horizon+residual`) with a budget of `k` lights and the
 /// papers' defaults otherwise; `None` for an unknown name or option.
 #[must_use]
 pub fn extractor(method: &str, k: usize) -> Option<Box<dyn LightExtractor>> {
@@ -73,6 +78,7 @@ pub fn extractor(method: &str, k: usize) -> Option<Box<dyn LightExtractor>> {
         return Some(Box::new(Residual::new(extractor(inner, k)?)));
     }
     let (base, above_horizon) = method.strip_suffix("+above-horizon").map_or((method, false), |b| (b, true));
+    let (base, weber) = base.strip_suffix("+weber").map_or((base, false), |b| (b, true));
     let inner: Box<dyn LightExtractor> = match base {
         "emissive-split" => Box::new(EmissiveSplit { lights: k, ..EmissiveSplit::default() }),
         "emissive-split+moment-cones" => {
@@ -84,5 +90,6 @@ pub fn extractor(method: &str, k: usize) -> Option<Box<dyn LightExtractor>> {
         "importance" => Box::new(ImportanceSampled { count: k, seed: 0 }),
         _ => return None,
     };
+    let inner: Box<dyn LightExtractor> = if weber { Box::new(Weber::new(inner)) } else { inner };
     Some(if above_horizon { Box::new(AboveHorizon::new(inner)) } else { inner })
 }

@@ -25,9 +25,123 @@
 //! component.
 
 use crate::decomposition::{Decomposition, ExtractedLight};
+use envmap_sphere::error::one_line;
 use glam::{Quat, Vec3};
+use scene::DistantLight;
+use serde::Deserialize;
 use serde_json::{Value, json};
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+/// A `lights.json` that cannot be read: names the file and the reason, on one line.
+#[derive(Debug, thiserror::Error)]
+pub enum LightsFileError {
+    /// The file cannot be read.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What the system said.
+        source: std::io::Error,
+    },
+    /// Not JSON of the schema (the position is serde_json's line and column).
+    #[error("{path}: not a lights.json: {reason}")]
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// What the parser said.
+        reason: String,
+    },
+    /// A light whose values are out of range.
+    #[error(
+        "{path}: light {index}{set} is invalid: direction must be finite and non-zero, solid_angle in (0, 4 pi], \
+         radiance finite and non-negative"
+    )]
+    InvalidLight {
+        /// The file.
+        path: PathBuf,
+        /// Index of the light in its set.
+        index: usize,
+        /// " of interleaved set N", or empty for the lights themselves.
+        set: String,
+    },
+}
+
+/// The lights a `lights.json` holds for rendering: the lights and the extra interleaved sets.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightsFile {
+    /// `lights[]`.
+    pub lights: Vec<DistantLight>,
+    /// `interleaved[][]` (may be empty).
+    pub interleaved: Vec<Vec<DistantLight>>,
+}
+
+#[derive(Deserialize)]
+struct RawFile {
+    lights: Vec<RawLight>,
+    #[serde(default)]
+    interleaved: Vec<Vec<RawLight>>,
+}
+
+#[derive(Deserialize)]
+struct RawLight {
+    direction: [f32; 3],
+    solid_angle: f32,
+    radiance: [f32; 3],
+}
+
+fn check_lights(path: &Path, raw: &[RawLight], set: Option<usize>) -> Result<Vec<DistantLight>, LightsFileError> {
+    raw.iter()
+        .enumerate()
+        .map(|(index, l)| {
+            let d = Vec3::from_array(l.direction);
+            let r = Vec3::from_array(l.radiance);
+            let ok = d.is_finite()
+                && d.length() > 0.0
+                && d.length().is_finite()
+                && l.solid_angle > 0.0
+                && l.solid_angle <= 4.0 * std::f32::consts::PI
+                && r.is_finite()
+                && r.min_element() >= 0.0;
+            if !ok {
+                return Err(LightsFileError::InvalidLight {
+                    path: path.to_path_buf(),
+                    index,
+                    set: set.map(|s| format!(" of interleaved set {s}")).unwrap_or_default(),
+                });
+            }
+            Ok(DistantLight { direction: d.normalize(), solid_angle: l.solid_angle, radiance: r })
+        })
+        .collect()
+}
+
+/// Reads the lights of a `lights.json` from its bytes (`lights[]` and `interleaved[][]`, each
+/// light's `direction`, `solid_angle` and `radiance`; other keys are ignored); `path` names the
+/// file in errors.
+///
+/// # Errors
+/// [`LightsFileError::Parse`] for anything but JSON of the schema (serde_json limits nesting,
+/// so deep input is an error too), [`LightsFileError::InvalidLight`] for values out of range.
+pub fn parse_lights_json(bytes: &[u8], path: &Path) -> Result<LightsFile, LightsFileError> {
+    let raw: RawFile = serde_json::from_slice(bytes)
+        .map_err(|e| LightsFileError::Parse { path: path.to_path_buf(), reason: one_line(&e.to_string()) })?;
+    let lights = check_lights(path, &raw.lights, None)?;
+    let interleaved = raw
+        .interleaved
+        .iter()
+        .enumerate()
+        .map(|(k, set)| check_lights(path, set, Some(k)))
+        .collect::<Result<_, _>>()?;
+    Ok(LightsFile { lights, interleaved })
+}
+
+/// [`parse_lights_json`] of the file at `path`.
+///
+/// # Errors
+/// [`LightsFileError::Io`] when it cannot be read, else as [`parse_lights_json`].
+pub fn read_lights_json(path: &Path) -> Result<LightsFile, LightsFileError> {
+    let bytes = std::fs::read(path).map_err(|source| LightsFileError::Io { path: path.to_path_buf(), source })?;
+    parse_lights_json(&bytes, path)
+}
 
 fn light_json(l: &ExtractedLight) -> Value {
     let p = l.power();

@@ -11,16 +11,7 @@ use std::f64::consts::PI;
 use std::path::PathBuf;
 
 fn shared_maps() -> Vec<PathBuf> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/envmaps");
-    let mut maps: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .flatten()
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|x| x == "exr" || x == "hdr"))
-        .collect();
-    maps.sort();
-    assert!(maps.len() >= 11);
-    maps
+    envmap_sphere::test_set::maps().unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn methods(k: usize) -> Vec<Box<dyn LightExtractor>> {

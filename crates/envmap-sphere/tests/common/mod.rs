@@ -1,4 +1,4 @@
-//! Shared helpers for the integration tests: the shared test maps and fixed-seed randomness.
+//! Helpers for the integration tests: the repository's test maps and fixed-seed randomness.
 
 #![allow(dead_code)]
 
@@ -7,27 +7,15 @@ use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use std::path::PathBuf;
 
-/// `../shared/envmaps` beside the repository (override with `ENVSHADOW_ENVMAPS`).
+/// The repository's test maps (`assets/envmaps`, or `ENVSHADOW_ENVMAPS`).
 pub fn envmaps_dir() -> PathBuf {
-    if let Ok(dir) = std::env::var("ENVSHADOW_ENVMAPS") {
-        return dir.into();
-    }
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/envmaps")
+    envmap_sphere::test_set::dir()
 }
 
-/// Every .exr and .hdr in the shared maps folder, sorted. Panics when there are none: the tests
-/// that use them must not pass vacuously.
+/// Every map of the test set, sorted. Panics when they are missing: the tests that use them must
+/// not pass vacuously.
 pub fn shared_maps() -> Vec<PathBuf> {
-    let dir = envmaps_dir();
-    let mut maps: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap_or_else(|e| panic!("{}: {e} (set ENVSHADOW_ENVMAPS)", dir.display()))
-        .flatten()
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|x| x == "exr" || x == "hdr"))
-        .collect();
-    maps.sort();
-    assert!(maps.len() >= 11, "expected the 11 shared maps in {}", dir.display());
-    maps
+    envmap_sphere::test_set::maps().unwrap_or_else(|e| panic!("{e}"))
 }
 
 pub fn rng(seed: u64) -> Pcg64Mcg {

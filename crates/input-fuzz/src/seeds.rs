@@ -1,0 +1,158 @@
+//! Small valid files to mutate, made here so the harness needs nothing beside the repository:
+//! Radiance `.hdr` (flat and run-length encoded), OpenEXR (every compression the loader meets,
+//! RGB, RGBA and f16 channels), and `lights.json` as `extract` writes it; and the library
+//! targets that load them as the commands do.
+
+use crate::{FUZZ_MAX_PIXELS, Format, Target};
+use envmap_sphere::{EnvMap, LoadOptions, NegativePolicy};
+use glam::Vec3;
+use std::io::Cursor;
+
+/// A small map with a bright spot, some zeros and a gradient: `w` x `h`.
+fn pixels(w: usize, h: usize) -> Vec<Vec3> {
+    (0..w * h)
+        .map(|k| {
+            let (i, j) = (k % w, k / w);
+            if i == w / 3 && j == h / 4 {
+                Vec3::new(900.0, 800.0, 700.0)
+            } else if (i + j) % 7 == 0 {
+                Vec3::ZERO
+            } else {
+                Vec3::new(i as f32 / w as f32, j as f32 / h as f32, 0.25)
+            }
+        })
+        .collect()
+}
+
+/// Radiance RGBE of one pixel.
+fn rgbe(c: Vec3) -> [u8; 4] {
+    let m = c.max_element();
+    if m < 1e-32 {
+        return [0; 4];
+    }
+    let e = m.log2().floor() as i32 + 1;
+    let scale = 256.0 / 2f32.powi(e);
+    [(c.x * scale) as u8, (c.y * scale) as u8, (c.z * scale) as u8, (e + 128).clamp(0, 255) as u8]
+}
+
+/// `.hdr` files: flat 16 x 8, run-length encoded 16 x 8 and 64 x 32 (the encoder's), and a flat
+/// one with extra header lines.
+#[must_use]
+pub fn hdr() -> Vec<Vec<u8>> {
+    let mut out = Vec::new();
+    for (w, h, header) in [
+        (16, 8, "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 8 +X 16\n"),
+        (16, 8, "#?RADIANCE\n# made by the fuzzer\nEXPOSURE=1.0\nFORMAT=32-bit_rle_rgbe\n\n-Y 8 +X 16\n"),
+    ] {
+        let mut bytes = header.as_bytes().to_vec();
+        for p in pixels(w, h) {
+            bytes.extend(rgbe(p));
+        }
+        out.push(bytes);
+    }
+    for (w, h) in [(16usize, 8usize), (64, 32)] {
+        let rgb: Vec<image::Rgb<f32>> = pixels(w, h).iter().map(|p| image::Rgb(p.to_array())).collect();
+        let mut bytes = Vec::new();
+        if image::codecs::hdr::HdrEncoder::new(&mut bytes).encode(&rgb, w, h).is_ok() {
+            out.push(bytes);
+        }
+    }
+    out
+}
+
+/// `.exr` files: 16 x 8 RGB f32 with no, RLE, ZIP, PIZ and DWAB compression, RGBA f16, and a
+/// Y-only image (no colour channels).
+#[must_use]
+pub fn exr() -> Vec<Vec<u8>> {
+    use exr::prelude::*;
+    let (w, h) = (16usize, 8usize);
+    let px = pixels(w, h);
+    let mut out = Vec::new();
+    for compression in
+        [Compression::Uncompressed, Compression::RLE, Compression::ZIP16, Compression::PIZ, Compression::DWAB(None)]
+    {
+        let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
+            let c = px[p.y() * w + p.x()];
+            (c.x, c.y, c.z)
+        });
+        let encoding = Encoding { compression, ..Encoding::UNCOMPRESSED };
+        let layer = Layer::new((w, h), LayerAttributes::named("rgb"), encoding, channels);
+        let mut bytes = Vec::new();
+        if Image::from_layer(layer).write().to_buffered(Cursor::new(&mut bytes)).is_ok() {
+            out.push(bytes);
+        }
+    }
+    let rgba = SpecificChannels::rgba(|p: Vec2<usize>| {
+        let c = px[p.y() * w + p.x()];
+        (f16::from_f32(c.x), f16::from_f32(c.y), f16::from_f32(c.z), f16::from_f32(1.0))
+    });
+    let layer = Layer::new((w, h), LayerAttributes::named("rgba"), Encoding::UNCOMPRESSED, rgba);
+    let mut bytes = Vec::new();
+    if Image::from_layer(layer).write().to_buffered(Cursor::new(&mut bytes)).is_ok() {
+        out.push(bytes);
+    }
+    let gray = AnyChannel::new("Y", FlatSamples::F32(vec![0.5; w * h]));
+    let layer = Layer::new(
+        (w, h),
+        LayerAttributes::named("gray"),
+        Encoding::UNCOMPRESSED,
+        AnyChannels::sort(SmallVec::from_vec(vec![gray])),
+    );
+    let mut bytes = Vec::new();
+    if Image::from_layer(layer).write().to_buffered(Cursor::new(&mut bytes)).is_ok() {
+        out.push(bytes);
+    }
+    out
+}
+
+/// `lights.json` files as `extract` writes them (two methods, with interleaved sets), and a
+/// minimal one.
+#[must_use]
+pub fn lights_json() -> Vec<Vec<u8>> {
+    use light_extract::LightExtractor;
+    let map = EnvMap::try_new(64, 32, pixels(64, 32)).unwrap_or_else(|_| EnvMap::constant(64, 32, Vec3::ONE));
+    let mut out = vec![br#"{"lights":[{"direction":[0,1,0],"solid_angle":0.01,"radiance":[1,2,3]}]}"#.to_vec()];
+    for method in ["median-cut", "emissive-split"] {
+        if let Some(Ok(d)) = light_extract::extractor(method, 4).map(|e| e.extract(&map)) {
+            let mut sets = d.interleaved();
+            sets.truncate(2);
+            if let Ok(text) = serde_json::to_vec_pretty(&d.to_json(&sets)) {
+                out.push(text);
+            }
+        }
+    }
+    out
+}
+
+/// The loaders the commands use, on the seeds above: maps (`info`, `extract`, `--envmap`, the
+/// `ambient.exr` beside a `lights.json`, read signed), images (`compare`) and `lights.json`
+/// (`render --lights`).
+#[must_use]
+pub fn library_targets() -> Vec<Target> {
+    let options = LoadOptions { max_pixels: FUZZ_MAX_PIXELS, ..LoadOptions::default() };
+    let signed = LoadOptions { negative: NegativePolicy::Keep, ..options };
+    let map = move |o: LoadOptions| {
+        move |bytes: &[u8], path: &std::path::Path| {
+            EnvMap::load_from_bytes(bytes, path, &o).map(|_| ()).map_err(|e| e.to_string())
+        }
+    };
+    let image = move |bytes: &[u8], path: &std::path::Path| {
+        envmap_sphere::load_rgb_image_from_bytes(bytes, path, &options).map(|_| ()).map_err(|e| e.to_string())
+    };
+    vec![
+        Target { name: "map.hdr", extension: "hdr", format: Format::Hdr, seeds: hdr(), run: Box::new(map(options)) },
+        Target { name: "map.exr", extension: "exr", format: Format::Exr, seeds: exr(), run: Box::new(map(options)) },
+        Target { name: "ambient.exr", extension: "exr", format: Format::Exr, seeds: exr(), run: Box::new(map(signed)) },
+        Target { name: "image.hdr", extension: "hdr", format: Format::Hdr, seeds: hdr(), run: Box::new(image) },
+        Target { name: "image.exr", extension: "exr", format: Format::Exr, seeds: exr(), run: Box::new(image) },
+        Target {
+            name: "lights.json",
+            extension: "json",
+            format: Format::Json,
+            seeds: lights_json(),
+            run: Box::new(|bytes, path| {
+                light_extract::output::parse_lights_json(bytes, path).map(|_| ()).map_err(|e| e.to_string())
+            }),
+        },
+    ]
+}
