@@ -97,8 +97,9 @@ pub fn describe_adapter(info: &wgpu::AdapterInfo) -> String {
 }
 
 /// Index of the adapter `wanted` picks among `infos`: the best by type, then backend, when
-/// `wanted` is `None`, OpenGL adapters last (our passes need more than GLSL offers); else the best whose name contains `wanted` (case-insensitive), or the
-/// best CPU implementation for `cpu`.
+/// `wanted` is `None`; else the best whose name contains `wanted` (case-insensitive), or the
+/// best CPU implementation for `cpu`. OpenGL adapters come last either way: our passes need
+/// more than GLSL offers.
 #[must_use]
 pub fn pick_adapter(infos: &[wgpu::AdapterInfo], wanted: Option<&str>) -> Option<usize> {
     let wanted = wanted.map(str::to_lowercase);

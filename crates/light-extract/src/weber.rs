@@ -243,9 +243,10 @@ impl<E> Weber<E> {
 #[must_use]
 pub fn compact_sources(map: &EnvMap, contrast: f64, max_half_angle: f64) -> Vec<CompactSource> {
     let (w, h) = (map.width() as usize, map.height() as usize);
-    let lum: Vec<f64> = map.pixels().iter().map(|p| f64::from(luminance(*p)).max(0.0)).collect();
-    let power: f64 =
-        (0..h).map(|j| map.texel_solid_angle(j as u32) * lum[j * w..(j + 1) * w].iter().sum::<f64>()).sum();
+    let lum: Vec<f32> = map.pixels().iter().map(|p| luminance(*p).max(0.0)).collect();
+    let power: f64 = (0..h)
+        .map(|j| map.texel_solid_angle(j as u32) * lum[j * w..(j + 1) * w].iter().map(|&y| f64::from(y)).sum::<f64>())
+        .sum();
     let mean = power / (4.0 * PI);
     if !(mean > 0.0 && mean.is_finite()) {
         return Vec::new();
@@ -253,23 +254,24 @@ pub fn compact_sources(map: &EnvMap, contrast: f64, max_half_angle: f64) -> Vec<
     let mut mask = vec![false; w * h];
     let mut out = Vec::new();
     let mut threshold = contrast * mean;
-    let mut pending: Vec<usize> = (0..w * h).collect();
-    // each round looks only inside the regions too wide the round before
-    while !pending.is_empty() && threshold.is_finite() {
-        let candidates: Vec<usize> = pending.iter().copied().filter(|&k| lum[k] > threshold).collect();
+    // the first round looks at every texel, each later one only inside the regions that were
+    // too wide the round before
+    let mut candidates: Vec<usize> = (0..w * h).filter(|&k| f64::from(lum[k]) > threshold).collect();
+    while !candidates.is_empty() && threshold.is_finite() {
         for &k in &candidates {
             mask[k] = true;
         }
-        pending.clear();
+        let mut wide = Vec::new();
         for comp in components(map, &candidates, &mut mask) {
             let source = describe(map, &comp);
             if f64::from(source.extent) <= max_half_angle {
                 out.push(source);
             } else {
-                pending.extend(comp);
+                wide.extend(comp);
             }
         }
         threshold *= 4.0;
+        candidates = wide.into_iter().filter(|&k| f64::from(lum[k]) > threshold).collect();
     }
     out
 }
