@@ -1,9 +1,10 @@
 //! `cargo xtask test`: the whole test suite, as CI runs it.
 //!
 //! Unit, integration and doc tests of every crate (the GPU ones on the best adapter present, or
-//! the one `--adapter` names; lavapipe where there is no GPU), one smoke run of every criterion bench (so benches never rot), and — when no test
-//! filter is given — the main job, `cargo xtask validate --quick`, with its thresholds. Prints
-//! the wall time.
+//! the one `--adapter` names; lavapipe where there is no GPU), one smoke run of every criterion
+//! bench (so benches never rot), and — when no test filter is given — the main job, `cargo xtask
+//! validate` with its defaults and thresholds, checking that the README's validate figures are
+//! this code's. Prints the wall time.
 
 use std::process::Command;
 use std::time::Instant;
@@ -32,10 +33,11 @@ pub fn run(adapter: Option<&str>, extra: &[String]) -> Result<(), String> {
         }
     }
     if extra.is_empty() {
-        outln!("xtask test: cargo xtask validate --check-readme README.md");
-        // the command's own defaults, as a user gets them
         // the main job with its defaults, as a user runs it, and the README's figures with it
-        let mut validate = vec!["validate", "--check-readme", "README.md"];
+        let readme = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../README.md");
+        let readme = readme.to_string_lossy();
+        outln!("xtask test: cargo xtask validate --check-readme {readme}");
+        let mut validate = vec!["validate", "--check-readme", &readme];
         validate.extend(adapter.map(|a| ["--adapter", a]).into_iter().flatten());
         crate::validate::run(&clap::Parser::parse_from(validate))?;
     }

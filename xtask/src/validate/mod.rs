@@ -12,11 +12,11 @@ mod report;
 use crate::render::load_map;
 use glam::Vec3;
 use gpu::{GBufferPass, ShadingPass};
+use gpu_stages::{MaskImages, Passes, SizeRow, gpu_render, room_masks};
 use light_extract::{EmissiveSplit, LightExtractor};
 use ref_tracer::metrics::{FlipTonemap, flip, rmse};
 use ref_tracer::{EnvLight, Integrator, LightSet, RenderSettings, SceneBvh, Strategy};
 use report::Report;
-use gpu_stages::{MaskImages, Passes, SizeRow, gpu_render, room_masks};
 use shadowmap_paraboloid::{ShadowMapper, ShadowSettings, Technique};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -367,4 +367,3 @@ pub fn parse_thresholds(text: &str, name: &str) -> Result<BTreeMap<String, f64>,
     }
     Ok(out)
 }
-
