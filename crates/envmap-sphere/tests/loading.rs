@@ -326,3 +326,57 @@ fn city_exr_is_read_from_its_d50_primaries() {
     assert!((ratio - Vec3::new(1.176, 0.976, 0.722)).abs().max_element() < 0.02, "{ratio}");
     assert_eq!(envmap_sphere::default_map(), map, "the embedded copy reads the same");
 }
+
+/// A small RGB f32 OpenEXR file with `compression`, in memory.
+fn exr_bytes(compression: exr::compression::Compression, channels: [&str; 3]) -> Vec<u8> {
+    use exr::prelude::*;
+    let (w, h) = (64usize, 32usize);
+    let list: Vec<AnyChannel<FlatSamples>> = channels
+        .iter()
+        .enumerate()
+        .map(|(c, name)| {
+            let values = (0..w * h).map(|k| ((k * (c + 3)) % 17) as f32 * 0.25).collect();
+            AnyChannel::new(*name, FlatSamples::F32(values))
+        })
+        .collect();
+    let encoding = Encoding { compression, ..Encoding::UNCOMPRESSED };
+    let layer =
+        Layer::new((w, h), LayerAttributes::named("rgb"), encoding, AnyChannels::sort(SmallVec::from_vec(list)));
+    let mut bytes = Vec::new();
+    Image::from_layer(layer).write().to_buffered(std::io::Cursor::new(&mut bytes)).expect("write exr");
+    bytes
+}
+
+#[test]
+fn dwa_chunks_claiming_absurd_counts_are_refused_before_decoding() {
+    // found by `cargo xtask fuzz`: the exr crate reserved memory by a chunk's AC count and
+    // aborted the process on 2^60
+    let bytes = exr_bytes(exr::compression::Compression::DWAB(None), ["R", "G", "B"]);
+    let (map, _) = EnvMap::load_from_bytes(&bytes, "dwab.exr", &LoadOptions::default()).expect("the valid file loads");
+    assert_eq!((map.width(), map.height()), (64, 32));
+    // 32 rows are one DWAB block: the offset table is one entry pointing just past itself, and
+    // the chunk there is (y: i32, size: i32, then 11 u64 counters: version, 7 sizes, AC and DC
+    // counts, AC compression)
+    let offset = |k: usize| u64::from_le_bytes(bytes[k..k + 8].try_into().unwrap_or([0; 8])) as usize;
+    let table = (8..bytes.len() - 8).find(|&k| offset(k) == k + 8).expect("the offset table");
+    let counters = table + 8 + 8;
+    for counter in [8usize, 9, 1, 6] {
+        let mut bad = bytes.clone();
+        let at = counters + 8 * counter;
+        bad[at..at + 8].copy_from_slice(&(1u64 << 60).to_le_bytes());
+        let err = EnvMap::load_from_bytes(&bad, "bad-dwab.exr", &LoadOptions::default()).expect_err("refused");
+        let text = err.to_string();
+        assert!(text.contains("bad-dwab.exr") && text.contains("DWA counter claims"), "{text}");
+    }
+}
+
+#[test]
+fn text_from_the_file_cannot_break_an_error_across_lines() {
+    // channel names are the file's own text: a newline among them is escaped
+    let bytes = exr_bytes(exr::compression::Compression::Uncompressed, ["R", "G", "B\nX"]);
+    let err = EnvMap::load_from_bytes(&bytes, "names.exr", &LoadOptions::default()).expect_err("no B channel");
+    let text = err.to_string();
+    assert!(!text.contains('\n') && text.contains("names.exr") && text.contains("\\n"), "{text}");
+    assert_eq!(envmap_sphere::error::one_line("a\tb\r\nc"), "a\\tb\\r\\nc");
+    assert_eq!(envmap_sphere::error::one_line("plain"), "plain");
+}
