@@ -38,7 +38,7 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// The main job: decompose the map into lights, render them on the GPU (lavapipe) with
+    /// The main job: decompose the map into lights, render them on the GPU (the best adapter) with
     /// shadow maps, render the ref-tracer reference, measure point-light shadow maps on `room`,
     /// and write target/validate/report.html. Fails when an error exceeds
     /// validate/thresholds.json.

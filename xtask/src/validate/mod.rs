@@ -31,7 +31,7 @@ pub struct ValidateArgs {
     /// Built-in scene lit by the map.
     #[arg(long, default_value = "spheres_box")]
     pub scene: String,
-    /// Smaller images and fewer samples: about 10 s on 2 cores once built.
+    /// Smaller images and fewer samples: about 17 s on 2 cores once built.
     #[arg(long)]
     pub quick: bool,
     /// Output directory.
