@@ -282,8 +282,3 @@ fn write_tables(rows: &[Row], args: &EvalArgs) -> Result<(), String> {
     outln!("\nwrote {} and {}", csv_path.display(), md_path.display());
     Ok(())
 }
-
-/// The repository's test maps (`assets/envmaps`, or `ENVSHADOW_ENVMAPS`).
-pub fn default_maps_dir() -> PathBuf {
-    envmap_sphere::test_set::dir()
-}

@@ -161,7 +161,7 @@ fn main() -> ExitCode {
         Command::Compare { reference, test } => render::compare(&reference, &test),
         Command::EvalLights { maps, scenes, lights, methods, spp, lights_spp, size, out } => {
             eval_lights::run(&eval_lights::EvalArgs {
-                maps: maps.unwrap_or_else(eval_lights::default_maps_dir),
+                maps: maps.unwrap_or_else(envmap_sphere::test_set::dir),
                 scenes,
                 lights,
                 methods,

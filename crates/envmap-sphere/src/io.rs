@@ -363,7 +363,10 @@ fn decode_exr(bytes: &[u8], path: &Path, options: &LoadOptions, latlong: bool) -
     use exr::prelude::*;
     let err =
         |reason: String| EnvMapError::Decode { path: path.to_path_buf(), format: "OpenEXR", reason: one_line(&reason) };
-    let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false).map_err(|e| err(e.to_string()))?;
+    // read once through a cursor: where it stops, the chunk offset tables begin
+    let mut cursor = Cursor::new(bytes);
+    let meta = exr::meta::MetaData::read_from_buffered(&mut cursor, false).map_err(|e| err(e.to_string()))?;
+    let table_start = usize::try_from(cursor.position()).unwrap_or(usize::MAX);
     let header = meta.headers.first().ok_or_else(|| err("no layers".into()))?;
     let size = header.layer_size;
     let (w, h) = check_size(path, size.width() as u64, size.height() as u64, options, latlong)?;
@@ -376,7 +379,7 @@ fn decode_exr(bytes: &[u8], path: &Path, options: &LoadOptions, latlong: bool) -
             bytes.len()
         )));
     }
-    check_dwa_chunks(bytes, &meta).map_err(err)?;
+    check_dwa_chunks(bytes, &meta, table_start).map_err(err)?;
     let compression = format!("{:?}", header.compression);
     let compression = compression.split('(').next().unwrap_or("").to_lowercase();
     let compression = if compression == "uncompressed" { "none".to_string() } else { compression };
@@ -426,19 +429,14 @@ fn decode_exr(bytes: &[u8], path: &Path, options: &LoadOptions, latlong: bool) -
 /// DWAA / DWAB chunks whose leading counters claim more values than their block can hold are
 /// refused here: the `exr` crate (1.74.2) reserves memory by those counters before checking
 /// them, and aborts the process on an absurd one (found by `cargo xtask fuzz`).
-fn check_dwa_chunks(bytes: &[u8], meta: &exr::meta::MetaData) -> Result<(), String> {
+/// `table_start` is where the headers end and the offset tables begin.
+fn check_dwa_chunks(bytes: &[u8], meta: &exr::meta::MetaData, table_start: usize) -> Result<(), String> {
     use exr::compression::Compression;
     use exr::meta::BlockDescription;
     if !meta.headers.iter().any(|h| matches!(h.compression, Compression::DWAA(_) | Compression::DWAB(_))) {
         return Ok(());
     }
-    // where the offset tables start: right after the headers
-    let mut cursor = Cursor::new(bytes);
-    if exr::meta::MetaData::read_from_buffered(&mut cursor, false).is_err() {
-        return Ok(()); // the decoder says why
-    }
     let multipart = meta.requirements.is_multilayer();
-    let table_start = usize::try_from(cursor.position()).unwrap_or(usize::MAX);
     let u64_at =
         |at: usize| bytes.get(at..at.checked_add(8)?).map(|b| u64::from_le_bytes(b.try_into().unwrap_or([0; 8])));
     let i32_at =

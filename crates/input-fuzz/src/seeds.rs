@@ -139,12 +139,31 @@ pub fn library_targets() -> Vec<Target> {
     let image = move |bytes: &[u8], path: &std::path::Path| {
         envmap_sphere::load_rgb_image_from_bytes(bytes, path, &options).map(|_| ()).map_err(|e| e.to_string())
     };
+    let (hdr, exr) = (hdr(), exr());
     vec![
-        Target { name: "map.hdr", extension: "hdr", format: Format::Hdr, seeds: hdr(), run: Box::new(map(options)) },
-        Target { name: "map.exr", extension: "exr", format: Format::Exr, seeds: exr(), run: Box::new(map(options)) },
-        Target { name: "ambient.exr", extension: "exr", format: Format::Exr, seeds: exr(), run: Box::new(map(signed)) },
-        Target { name: "image.hdr", extension: "hdr", format: Format::Hdr, seeds: hdr(), run: Box::new(image) },
-        Target { name: "image.exr", extension: "exr", format: Format::Exr, seeds: exr(), run: Box::new(image) },
+        Target {
+            name: "map.hdr",
+            extension: "hdr",
+            format: Format::Hdr,
+            seeds: hdr.clone(),
+            run: Box::new(map(options)),
+        },
+        Target {
+            name: "map.exr",
+            extension: "exr",
+            format: Format::Exr,
+            seeds: exr.clone(),
+            run: Box::new(map(options)),
+        },
+        Target {
+            name: "ambient.exr",
+            extension: "exr",
+            format: Format::Exr,
+            seeds: exr.clone(),
+            run: Box::new(map(signed)),
+        },
+        Target { name: "image.hdr", extension: "hdr", format: Format::Hdr, seeds: hdr.clone(), run: Box::new(image) },
+        Target { name: "image.exr", extension: "exr", format: Format::Exr, seeds: exr.clone(), run: Box::new(image) },
         Target {
             name: "lights.json",
             extension: "json",

@@ -244,10 +244,7 @@ impl<E> Weber<E> {
 pub fn compact_sources(map: &EnvMap, contrast: f64, max_half_angle: f64) -> Vec<CompactSource> {
     let (w, h) = (map.width() as usize, map.height() as usize);
     let lum: Vec<f32> = map.pixels().iter().map(|p| luminance(*p).max(0.0)).collect();
-    let power: f64 = (0..h)
-        .map(|j| map.texel_solid_angle(j as u32) * lum[j * w..(j + 1) * w].iter().map(|&y| f64::from(y)).sum::<f64>())
-        .sum();
-    let mean = power / (4.0 * PI);
+    let mean = envmap_sphere::color::luminance_f64(map.power()) / (4.0 * PI);
     if !(mean > 0.0 && mean.is_finite()) {
         return Vec::new();
     }
