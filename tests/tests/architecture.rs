@@ -98,8 +98,11 @@ fn gpu_layer_and_shadow_techniques_stand_apart_from_the_reference() {
     assert!(gpu.contains("wgpu") && gpu.contains("scene"), "gpu's graph is incomplete: {gpu:?}");
     let ours: Vec<_> = gpu.iter().filter(|d| OURS.contains(&d.as_str()) && *d != "envmap-sphere").collect();
     assert!(ours.is_empty(), "gpu depends on {ours:?}");
-    let shadows = transitive(&graph, "shadowmap-paraboloid");
-    for banned in ["ref-tracer", "light-extract", "obvhs"] {
-        assert!(!shadows.contains(banned), "shadowmap-paraboloid depends on {banned}");
+    for technique in ["shadowmap-paraboloid", "penumbra-wedge"] {
+        let shadows = transitive(&graph, technique);
+        assert!(shadows.contains("gpu"), "{technique} does not build on gpu: {shadows:?}");
+        for banned in ["ref-tracer", "light-extract", "obvhs"] {
+            assert!(!shadows.contains(banned), "{technique} depends on {banned}");
+        }
     }
 }

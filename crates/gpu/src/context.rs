@@ -178,6 +178,7 @@ impl Gpu {
         let adapter = &all[k];
         let info = adapter.get_info();
         let wanted = wgpu::Features::CLIP_DISTANCES
+            | wgpu::Features::FLOAT32_BLENDABLE
             | wgpu::Features::TIMESTAMP_QUERY
             | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
         let features = adapter.features() & wanted;

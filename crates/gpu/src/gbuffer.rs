@@ -26,12 +26,24 @@ pub struct GBuffer {
 /// Projection × view of `camera` for wgpu's clip space (depth in [0, 1]); `near`/`far` in metres.
 #[must_use]
 pub fn view_projection(camera: &scene::Camera, near: f32, far: f32) -> Mat4 {
+    let (fov_y, aspect, view) = view_and_fov(camera);
+    glam::camera::rh::proj::directx::perspective(fov_y, aspect, near, far) * view
+}
+
+/// (vertical field of view, aspect ratio, view matrix) of `camera`.
+fn view_and_fov(camera: &scene::Camera) -> (f32, f32, Mat4) {
     let aspect = camera.width as f32 / camera.height as f32;
     let tan_half_x = (camera.hfov_degrees.to_radians() * 0.5).tan();
-    let fov_y = 2.0 * (tan_half_x / aspect).atan();
     let (_, up, forward) = camera.basis();
-    glam::camera::rh::proj::directx::perspective(fov_y, aspect, near, far)
-        * glam::camera::rh::view::look_to_mat4(camera.eye, forward, up)
+    (2.0 * (tan_half_x / aspect).atan(), aspect, glam::camera::rh::view::look_to_mat4(camera.eye, forward, up))
+}
+
+/// As [`view_projection`] with the far plane at infinity: what passes that draw geometry
+/// extruded far beyond the scene (shadow volumes) use, so that no far plane cuts it.
+#[must_use]
+pub fn view_projection_infinite(camera: &scene::Camera, near: f32) -> Mat4 {
+    let (fov_y, aspect, view) = view_and_fov(camera);
+    glam::camera::rh::proj::directx::perspective_infinite(fov_y, aspect, near) * view
 }
 
 #[repr(C)]

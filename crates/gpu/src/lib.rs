@@ -11,6 +11,7 @@
 //! println!("{}", gpu.describe());
 //! ```
 
+pub mod accumulate;
 mod context;
 pub mod fullscreen;
 mod gbuffer;
@@ -19,12 +20,14 @@ mod readback;
 mod shade;
 pub mod shader;
 mod target;
+mod technique;
 mod timer;
 
 pub use context::{ADAPTER_ENV, Gpu, GpuError, adapters, describe_adapter, pick_adapter};
-pub use gbuffer::{GBUFFER_FORMAT, GBuffer, GBufferPass, view_projection};
+pub use gbuffer::{GBUFFER_FORMAT, GBuffer, GBufferPass, view_projection, view_projection_infinite};
 pub use geometry::{Chunk, SceneGeometry, ShadowGeometry, scene_triangles};
 pub use readback::{read_texture_f32, read_texture_rgba};
 pub use shade::{Background, HDR_FORMAT, ShadeLight, ShadeParams, ShadingPass, Visibility};
 pub use target::{layer_view, render_target};
+pub use technique::{LightShape, Receivers, ShadowPassReport, ShadowTechnique, render_visibility, totals};
 pub use timer::Clock;

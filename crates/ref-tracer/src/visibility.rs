@@ -41,3 +41,78 @@ pub fn light_visibility(bvh: &SceneBvh, points: &[(Vec3, Vec3)], light: Visibili
         })
         .collect()
 }
+
+/// An area light whose visible fraction is traced.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AreaLight {
+    /// A distant cone light: unit direction towards it and its half-angle (radians).
+    Cone {
+        /// Unit direction towards the light.
+        direction: Vec3,
+        /// Half-angle, radians.
+        half_angle: f32,
+    },
+    /// A local spherical light.
+    Sphere {
+        /// Centre.
+        center: Vec3,
+        /// Radius.
+        radius: f32,
+    },
+}
+
+/// For each `(position, geometric normal)`, the fraction of `light`'s cone of directions above
+/// the surface (as seen from the point, uniform in solid angle) that reaches it unoccluded,
+/// from `n` × `n` stratified directions (cell centres in (cos θ, φ), so the same points give
+/// the same answer); `None` for points to skip. The normal is the side that is shaded (the
+/// G-buffer's, facing the camera): directions below it are the surface's own horizon, which the
+/// shading's cosine already removes, so they count neither way. A light wholly below the
+/// surface gives `None` (nothing to shadow: the shading gives it nothing there); a point inside
+/// a sphere light sees all of it.
+#[must_use]
+pub fn area_light_visibility(bvh: &SceneBvh, points: &[(Vec3, Vec3)], light: AreaLight, n: u32) -> Vec<Option<f32>> {
+    let eps = bvh.epsilon();
+    let n = n.max(1);
+    points
+        .par_iter()
+        .map(|&(p, ng)| {
+            if !p.is_finite() {
+                return None;
+            }
+            let (axis, cos_max, center_radius) = match light {
+                AreaLight::Cone { direction, half_angle } => {
+                    (direction.normalize_or(Vec3::Y), half_angle.clamp(0.0, std::f32::consts::PI).cos(), None)
+                }
+                AreaLight::Sphere { center, radius } => {
+                    let d = center.distance(p);
+                    if d <= radius {
+                        return Some(1.0);
+                    }
+                    ((center - p) / d, (1.0 - (radius / d).powi(2)).max(0.0).sqrt(), Some((center, radius)))
+                }
+            };
+            let frame = scene::brdf::Frame::new(axis);
+            let (mut lit, mut above) = (0u32, 0u32);
+            for i in 0..n {
+                for j in 0..n {
+                    let cos = 1.0 - (i as f32 + 0.5) / n as f32 * (1.0 - cos_max);
+                    let sin = (1.0 - cos * cos).max(0.0).sqrt();
+                    let (s, c) = (std::f32::consts::TAU * (j as f32 + 0.5) / n as f32).sin_cos();
+                    let dir = frame.to_world(Vec3::new(sin * c, sin * s, cos)).normalize();
+                    let t_max = center_radius.map_or(f32::INFINITY, |(c, r)| {
+                        // nearest hit of the sphere: occluders beyond it do not count
+                        let oc = c - p;
+                        let b = oc.dot(dir);
+                        (b - (b * b - oc.length_squared() + r * r).max(0.0).sqrt() - eps).max(0.0)
+                    });
+                    if ng.dot(dir) <= 0.0 {
+                        continue;
+                    }
+                    above += 1;
+                    lit += u32::from(!bvh.occluded(p + ng * eps, dir, t_max));
+                }
+            }
+            (above > 0).then(|| lit as f32 / above as f32)
+        })
+        .collect()
+}

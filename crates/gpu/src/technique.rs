@@ -1,0 +1,192 @@
+//! The one interface of shadow techniques: given a frame's receivers (its G-buffer and what the
+//! camera sees) and a light's shape, write the light's visibility layer. Shadow maps (hard, PCF,
+//! PCSS, N samples), penumbra wedges and uploaded ray-traced visibility all implement
+//! [`ShadowTechnique`]; the shading pass only reads the layers, and `validate` and the trade
+//! report iterate over techniques through it.
+//!
+//! [`render_visibility`] is the frame loop every caller shares: it skips lights that no visible
+//! receiver can see (no shadow pass for a light nobody sees) and reports what it skipped.
+
+use crate::context::{Gpu, GpuError};
+use crate::gbuffer::GBuffer;
+use crate::shade::Visibility;
+use crate::timer::Clock;
+use glam::Vec3;
+use std::time::Duration;
+
+/// A light as shadow techniques see it: where it is and how large, not its colour.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightShape {
+    /// A distant cone light (the extracted lights): the disk is the cone's cross-section.
+    Distant {
+        /// Unit direction towards the light (the cone's axis).
+        direction: Vec3,
+        /// Half-angle of the cone, radians, in [0, pi/2).
+        half_angle: f32,
+    },
+    /// A local spherical light; radius 0 is a point light.
+    Sphere {
+        /// Centre, metres.
+        center: Vec3,
+        /// Radius, metres.
+        radius: f32,
+    },
+}
+
+impl LightShape {
+    /// The largest half-angle techniques accept: wider cones are clamped to it (a cone of
+    /// 90 degrees or more has no disk cross-section).
+    pub const MAX_HALF_ANGLE: f32 = 1.5;
+
+    /// Half-angle the light subtends from `p` (0 for a point light; pi/2 inside a sphere light).
+    #[must_use]
+    pub fn half_angle_at(&self, p: Vec3) -> f32 {
+        match *self {
+            LightShape::Distant { half_angle, .. } => half_angle.clamp(0.0, Self::MAX_HALF_ANGLE),
+            LightShape::Sphere { center, radius } => {
+                let d = center.distance(p);
+                if d <= radius { std::f32::consts::FRAC_PI_2 } else { (radius / d).asin() }
+            }
+        }
+    }
+
+    /// Unit direction from `p` to the light's centre.
+    #[must_use]
+    pub fn direction_from(&self, p: Vec3) -> Vec3 {
+        match *self {
+            LightShape::Distant { direction, .. } => direction.normalize_or(Vec3::Y),
+            LightShape::Sphere { center, .. } => (center - p).normalize_or(Vec3::Y),
+        }
+    }
+
+    /// Whether any part of the light is above the plane of a surface at `p` with normal `n`.
+    #[must_use]
+    pub fn reaches(&self, p: Vec3, n: Vec3) -> bool {
+        let d = self.direction_from(p);
+        n.dot(d) > -self.half_angle_at(p).sin()
+    }
+}
+
+impl From<&scene::DistantLight> for LightShape {
+    fn from(l: &scene::DistantLight) -> Self {
+        LightShape::Distant { direction: l.direction.normalize_or(Vec3::Y), half_angle: l.half_angle() }
+    }
+}
+
+impl From<&scene::PointLight> for LightShape {
+    fn from(l: &scene::PointLight) -> Self {
+        LightShape::Sphere { center: l.position, radius: 0.0 }
+    }
+}
+
+/// What a frame gives shadow techniques: the G-buffer on the GPU and, on the CPU, the visible
+/// surface points (position, geometric normal; NaN positions for background pixels) with their
+/// bounds. Techniques use the bounds to spend work only where receivers are.
+pub struct Receivers<'a> {
+    /// The frame's G-buffer.
+    pub gbuffer: &'a GBuffer,
+    /// The visible points, row-major, as [`GBuffer::read_points`] returns them.
+    pub points: &'a [(Vec3, Vec3)],
+    /// Axis-aligned bounds of the finite points, `None` when the camera sees nothing.
+    pub bounds: Option<(Vec3, Vec3)>,
+}
+
+impl<'a> Receivers<'a> {
+    /// The receivers of `gbuffer`, whose points `points` were read back from it.
+    #[must_use]
+    pub fn new(gbuffer: &'a GBuffer, points: &'a [(Vec3, Vec3)]) -> Self {
+        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        for (p, _) in points.iter().filter(|(p, _)| p.is_finite()) {
+            lo = lo.min(*p);
+            hi = hi.max(*p);
+        }
+        Self { gbuffer, points, bounds: lo.is_finite().then_some((lo, hi)) }
+    }
+
+    /// Whether any visible receiver has part of `light` above its surface: a light no receiver
+    /// faces lights nothing, so it needs no shadow pass.
+    #[must_use]
+    pub fn any_faces(&self, light: &LightShape) -> bool {
+        self.points.iter().any(|(p, n)| p.is_finite() && light.reaches(*p, *n))
+    }
+}
+
+/// What one technique did for one light.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ShadowPassReport {
+    /// GPU time of the light's passes (generation and visibility).
+    pub time: Duration,
+    /// The clock `time` comes from, `None` when nothing ran.
+    pub clock: Option<Clock>,
+    /// Why the light got no shadow pass (its layer stays lit), or `None`.
+    pub skipped: Option<String>,
+    /// Primitives drawn (triangles into maps, volume and wedge triangles).
+    pub primitives: u64,
+    /// Work that was left out because it could not matter (e.g. wedges of edges whose shadow
+    /// cannot reach a visible receiver), as `(what, how many)`.
+    pub culled: Vec<(&'static str, u64)>,
+}
+
+/// A GPU shadow technique: writes one light's visibility layer (1 lit, 0 shadowed) for a frame.
+pub trait ShadowTechnique {
+    /// Name, e.g. `wedge_raster` or `pcss_2048`; validate's rows prefix it with `gpu_`.
+    fn name(&self) -> String;
+
+    /// Whether it can shadow `light` (a cube map cannot shadow a distant light).
+    fn supports(&self, light: &LightShape) -> bool;
+
+    /// Writes `light`'s visibility of every G-buffer pixel of `receivers` into `target`.
+    ///
+    /// # Errors
+    /// A light the technique does not support; GPU failures.
+    fn write_visibility(
+        &self,
+        gpu: &Gpu,
+        receivers: &Receivers,
+        light: &LightShape,
+        target: &wgpu::TextureView,
+    ) -> Result<ShadowPassReport, GpuError>;
+}
+
+/// Writes every light's layer of `visibility` with `technique`, skipping lights that no visible
+/// receiver faces (their layers stay lit: the shading pass gives them nothing there anyway).
+///
+/// # Errors
+/// [`GpuError::TooLarge`] when `visibility` has fewer layers than lights; the technique's
+/// errors.
+pub fn render_visibility(
+    gpu: &Gpu,
+    technique: &dyn ShadowTechnique,
+    receivers: &Receivers,
+    lights: &[LightShape],
+    visibility: &Visibility,
+) -> Result<Vec<ShadowPassReport>, GpuError> {
+    if lights.len() as u64 > u64::from(visibility.layers()) {
+        return Err(GpuError::TooLarge {
+            what: "lights for the visibility layers",
+            size: lights.len() as u64,
+            limit: visibility.layers().into(),
+        });
+    }
+    let mut out = Vec::with_capacity(lights.len());
+    for (k, light) in lights.iter().enumerate() {
+        if !receivers.any_faces(light) {
+            out.push(ShadowPassReport {
+                skipped: Some("no visible receiver faces it".into()),
+                ..ShadowPassReport::default()
+            });
+            continue;
+        }
+        out.push(technique.write_visibility(gpu, receivers, light, &visibility.layer(k as u32))?);
+    }
+    Ok(out)
+}
+
+/// Totals over a frame's reports: (GPU time, lights shadowed, lights skipped, primitives).
+#[must_use]
+pub fn totals(reports: &[ShadowPassReport]) -> (Duration, usize, usize, u64) {
+    let time = reports.iter().map(|r| r.time).sum();
+    let skipped = reports.iter().filter(|r| r.skipped.is_some()).count();
+    let primitives = reports.iter().map(|r| r.primitives).sum();
+    (time, reports.len() - skipped, skipped, primitives)
+}

@@ -1,0 +1,211 @@
+//! Casters with edge adjacency, and their silhouettes from a light's centre.
+//!
+//! Each object's mesh is welded by exact vertex position (flat-shaded meshes repeat corners per
+//! face). A mesh whose every edge joins exactly two faces wound oppositely is **closed**: only
+//! its faces that face the light cast, and its silhouette is where lit faces meet unlit ones.
+//! Any other mesh (the ground quad, a non-manifold or inconsistently wound mesh) casts as a
+//! **two-sided sheet**: every face casts with the winding of its side that faces the light. That
+//! is exact for open surfaces and never garbage for broken ones; where such a surface folds, two
+//! layers cover the light and the wedge sum counts them twice (clamped; the overlap artefact).
+//!
+//! Silhouette edges are oriented as their lit face winds, so that seen from the light the lit
+//! region lies to their left; the hard volume and the wedges use that one orientation.
+
+use glam::Vec3;
+use gpu::LightShape;
+use std::collections::HashMap;
+
+/// One object's welded mesh.
+#[derive(Clone, Debug)]
+pub struct Caster {
+    /// The object's name.
+    pub name: String,
+    /// Welded positions.
+    pub positions: Vec<Vec3>,
+    /// Non-degenerate triangles over `positions`.
+    pub triangles: Vec<[u32; 3]>,
+    /// Closed and consistently wound (see the module doc); else it casts as a two-sided sheet.
+    pub closed: bool,
+    /// Bounding sphere (centre, radius).
+    pub bounds: (Vec3, f32),
+}
+
+impl Caster {
+    /// Welds `positions` / `indices` and classifies the result.
+    #[must_use]
+    pub fn new(name: &str, positions: &[Vec3], indices: &[[u32; 3]]) -> Self {
+        let mut welded: Vec<Vec3> = Vec::new();
+        let mut index: HashMap<[u32; 3], u32> = HashMap::new();
+        // +0.0 makes -0.0 and 0.0 one key
+        let key = |p: Vec3| [(p.x + 0.0).to_bits(), (p.y + 0.0).to_bits(), (p.z + 0.0).to_bits()];
+        let remap: Vec<u32> = positions
+            .iter()
+            .map(|&p| {
+                *index.entry(key(p)).or_insert_with(|| {
+                    welded.push(p);
+                    (welded.len() - 1) as u32
+                })
+            })
+            .collect();
+        let triangles: Vec<[u32; 3]> = indices
+            .iter()
+            .filter(|t| t.iter().all(|&i| (i as usize) < remap.len()))
+            .map(|t| t.map(|i| remap[i as usize]))
+            .filter(|&[a, b, c]| {
+                let [pa, pb, pc] = [a, b, c].map(|i| welded[i as usize]);
+                a != b && b != c && a != c && (pb - pa).cross(pc - pa).length_squared() > 0.0
+            })
+            .collect();
+        // per undirected edge: (faces winding it low -> high, faces winding it high -> low)
+        let mut edges: HashMap<(u32, u32), (u32, u32)> = HashMap::new();
+        for t in &triangles {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                let e = edges.entry((a.min(b), a.max(b))).or_default();
+                if a < b {
+                    e.0 += 1;
+                } else {
+                    e.1 += 1;
+                }
+            }
+        }
+        let closed = !triangles.is_empty() && edges.values().all(|&c| c == (1, 1));
+        let (lo, hi) = welded
+            .iter()
+            .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+        let center = if lo.is_finite() { 0.5 * (lo + hi) } else { Vec3::ZERO };
+        let radius = welded.iter().map(|p| p.distance(center)).fold(0.0, f32::max);
+        Self { name: name.into(), positions: welded, triangles, closed, bounds: (center, radius) }
+    }
+}
+
+/// Every object of a scene as a caster.
+#[derive(Clone, Debug)]
+pub struct Casters {
+    /// One per object, in the scene's order.
+    pub casters: Vec<Caster>,
+}
+
+/// A light's silhouette and lit faces for a set of casters.
+#[derive(Clone, Debug, Default)]
+pub struct Silhouette {
+    /// Oriented silhouette edges (lit region to the left seen from the light).
+    pub edges: Vec<[Vec3; 2]>,
+    /// The faces that cast, wound to face the light: the hard volume's front cap.
+    pub lit_faces: Vec<[Vec3; 3]>,
+}
+
+impl Casters {
+    /// The casters of `scene`, one per object.
+    #[must_use]
+    pub fn new(scene: &scene::Scene) -> Self {
+        Self {
+            casters: scene.objects.iter().map(|o| Caster::new(&o.name, &o.mesh.positions, &o.mesh.indices)).collect(),
+        }
+    }
+
+    /// Names of the objects that cast as two-sided sheets (not closed).
+    #[must_use]
+    pub fn open(&self) -> Vec<&str> {
+        self.casters.iter().filter(|c| !c.closed).map(|c| c.name.as_str()).collect()
+    }
+
+    /// The silhouette of the casters `keep` accepts, from `light`'s centre.
+    #[must_use]
+    pub fn silhouette(&self, light: &LightShape, mut keep: impl FnMut(&Caster) -> bool) -> Silhouette {
+        let mut out = Silhouette::default();
+        for c in self.casters.iter().filter(|c| keep(c)) {
+            silhouette_of(c, light, &mut out);
+        }
+        out
+    }
+}
+
+/// Whether a face with unit-free normal `n` through `a` faces the light's centre: > 0 faces,
+/// < 0 faces away, 0 edge-on.
+fn facing(n: Vec3, a: Vec3, light: &LightShape) -> f32 {
+    match *light {
+        LightShape::Distant { direction, .. } => n.dot(direction),
+        LightShape::Sphere { center, .. } => n.dot(center - a),
+    }
+}
+
+fn silhouette_of(c: &Caster, light: &LightShape, out: &mut Silhouette) {
+    // net directed count per undirected edge: +1 per lit face winding it low -> high
+    let mut net: HashMap<(u32, u32), i32> = HashMap::new();
+    for &[a, b, cc] in &c.triangles {
+        let [pa, pb, pc] = [a, b, cc].map(|i| c.positions[i as usize]);
+        let f = facing((pb - pa).cross(pc - pa), pa, light);
+        let tri = if f > 0.0 {
+            [a, b, cc]
+        } else if f < 0.0 && !c.closed {
+            [a, cc, b]
+        } else {
+            continue;
+        };
+        out.lit_faces.push(tri.map(|i| c.positions[i as usize]));
+        for k in 0..3 {
+            let (u, v) = (tri[k], tri[(k + 1) % 3]);
+            *net.entry((u.min(v), u.max(v))).or_default() += if u < v { 1 } else { -1 };
+        }
+    }
+    let mut keys: Vec<_> = net.into_iter().filter(|&(_, n)| n != 0).collect();
+    // a fixed order: the GPU sums edge terms in draw order
+    keys.sort_unstable();
+    for ((lo, hi), n) in keys {
+        let (a, b) = if n > 0 { (lo, hi) } else { (hi, lo) };
+        for _ in 0..n.unsigned_abs() {
+            out.edges.push([c.positions[a as usize], c.positions[b as usize]]);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cube() -> scene::Mesh {
+        scene::Mesh::cuboid(Vec3::ZERO, Vec3::ONE)
+    }
+
+    #[test]
+    fn cuboid_welds_closed_and_ground_quad_is_open() {
+        let c = cube();
+        let caster = Caster::new("box", &c.positions, &c.indices);
+        assert!(caster.closed);
+        assert_eq!(caster.positions.len(), 8);
+        let q = scene::Mesh::quad(Vec3::ZERO, Vec3::X, Vec3::Z, 2, 2);
+        assert!(!Caster::new("ground", &q.positions, &q.indices).closed);
+    }
+
+    #[test]
+    fn cube_silhouette_from_above_is_its_top_square_counter_clockwise() {
+        let c = cube();
+        let casters = Casters { casters: vec![Caster::new("box", &c.positions, &c.indices)] };
+        let light = LightShape::Distant { direction: Vec3::Y, half_angle: 0.01 };
+        let s = casters.silhouette(&light, |_| true);
+        assert_eq!(s.edges.len(), 4);
+        assert_eq!(s.lit_faces.len(), 2);
+        // seen from above (+y), counter-clockwise in (x, -z) = (x, y') coordinates: the signed
+        // area of the loop about its centre is positive
+        let centre = Vec3::new(0.5, 1.0, 0.5);
+        let area: f32 = s.edges.iter().map(|[a, b]| (*a - centre).cross(*b - centre).y).sum();
+        assert!(area > 0.0, "{area}");
+        for [a, b] in &s.edges {
+            assert!((a.y - 1.0).abs() < 1e-6 && (b.y - 1.0).abs() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn open_sheet_casts_from_either_side_with_the_same_outline() {
+        let q = scene::Mesh::quad(Vec3::ZERO, Vec3::X, Vec3::Z, 3, 3);
+        let casters = Casters { casters: vec![Caster::new("ground", &q.positions, &q.indices)] };
+        for d in [Vec3::Y, Vec3::NEG_Y] {
+            let s = casters.silhouette(&LightShape::Distant { direction: d, half_angle: 0.1 }, |_| true);
+            assert_eq!(s.edges.len(), 12, "the 3 x 3 grid's boundary");
+            assert_eq!(s.lit_faces.len(), 18);
+            let area: f32 = s.edges.iter().map(|[a, b]| a.cross(*b).dot(d)).sum();
+            assert!(area > 0.0, "counter-clockwise seen from the light at {d}: {area}");
+        }
+    }
+}

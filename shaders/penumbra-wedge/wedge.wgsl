@@ -1,0 +1,126 @@
+// Penumbra wedges: per pixel of an edge's conservative footprint, the edge's signed coverage
+// of the light's disk seen from the G-buffer point, a_e / pi, added to the accumulator's g
+// (`penumbra_wedge::coverage` is the same computation on the CPU; its doc derives it).
+
+struct Light {
+    // xyz unit direction towards a distant light, or a sphere light's centre
+    position_or_direction: vec4<f32>,
+    // x 0 distant, 1 sphere; y half-angle (distant) or radius (sphere)
+    config: vec4<f32>,
+}
+
+struct Edge {
+    v0: vec4<f32>,
+    v1: vec4<f32>,
+}
+
+const PI: f32 = 3.14159265358979;
+const MAX_HALF_ANGLE: f32 = 1.5;
+
+@group(0) @binding(0) var<uniform> light: Light;
+@group(0) @binding(1) var<storage, read> edges: array<Edge>;
+@group(0) @binding(2) var g_position: texture_2d<f32>;
+
+struct VsOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) @interpolate(flat) edge: u32,
+}
+
+@vertex
+fn vs(@location(0) ndc: vec2<f32>, @location(1) edge: u32) -> VsOut {
+    var out: VsOut;
+    out.clip = vec4<f32>(ndc, 0.5, 1.0);
+    out.edge = edge;
+    return out;
+}
+
+// G(h, s) = atan(s / h) / 2 - h s / 2 over the chord |s| <= sqrt(1 - h^2), constant beyond.
+fn g_term(h: f32, s_in: f32) -> f32 {
+    let c = sqrt(max(1.0 - h * h, 0.0));
+    let s = clamp(s_in, -c, c);
+    var phi = atan2(s, h);
+    if h < 0.0 {
+        phi = -atan2(s, -h);
+    }
+    return 0.5 * phi - 0.5 * h * s;
+}
+
+// a_e / pi of the projected segment q0 -> q1 (unit-disk coordinates).
+fn segment_term(q0: vec2<f32>, q1: vec2<f32>) -> f32 {
+    let d = q1 - q0;
+    let len = length(d);
+    if !(len > 1e-12) || len > 3.0e38 {
+        return 0.0;
+    }
+    let s_hat = d / len;
+    let n_hat = vec2<f32>(s_hat.y, -s_hat.x);
+    let h = dot(q0, n_hat);
+    if abs(h) >= 1.0 {
+        return 0.0;
+    }
+    return (g_term(h, dot(q1, s_hat)) - g_term(h, dot(q0, s_hat))) / PI;
+}
+
+fn edge_term(p: vec3<f32>, v0: vec3<f32>, v1: vec3<f32>) -> f32 {
+    var z: vec3<f32>;
+    var alpha: f32;
+    var z_max = 3.0e38;
+    if light.config.x < 0.5 {
+        z = light.position_or_direction.xyz;
+        alpha = light.config.y;
+    } else {
+        let to_c = light.position_or_direction.xyz - p;
+        let dist = length(to_c);
+        z = to_c / max(dist, 1e-30);
+        alpha = select(asin(min(light.config.y / dist, 1.0)), PI * 0.5, dist <= light.config.y);
+        z_max = dist * cos(alpha) * cos(alpha);
+    }
+    alpha = clamp(alpha, 1e-7, MAX_HALF_ANGLE);
+    let helper = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(z.x) > 0.9);
+    let x = normalize(cross(helper, z));
+    let y = cross(z, x);
+    let tan_a = tan(alpha);
+    let d0 = v0 - p;
+    let d1 = v1 - p;
+    let z0 = dot(d0, z);
+    let z1 = dot(d1, z);
+    let z_min = 1e-6 * max(length(d0), length(d1));
+    // clip to z_min <= z <= z_max
+    var t0 = 0.0;
+    var t1 = 1.0;
+    let dz = z1 - z0;
+    if z0 < z_min && z1 < z_min {
+        return 0.0;
+    }
+    if z0 < z_min {
+        t0 = clamp((z_min - z0) / dz, 0.0, 1.0);
+    } else if z1 < z_min {
+        t1 = clamp((z_min - z0) / dz, 0.0, 1.0);
+    }
+    if z0 > z_max && z1 > z_max {
+        return 0.0;
+    }
+    if z0 > z_max {
+        t0 = max(t0, clamp((z_max - z0) / dz, 0.0, 1.0));
+    } else if z1 > z_max {
+        t1 = min(t1, clamp((z_max - z0) / dz, 0.0, 1.0));
+    }
+    if t0 >= t1 {
+        return 0.0;
+    }
+    let a = d0 + (d1 - d0) * t0;
+    let b = d0 + (d1 - d0) * t1;
+    let qa = vec2<f32>(dot(a, x), dot(a, y)) / (max(dot(a, z), z_min) * tan_a);
+    let qb = vec2<f32>(dot(b, x), dot(b, y)) / (max(dot(b, z), z_min) * tan_a);
+    return segment_term(qa, qb);
+}
+
+@fragment
+fn fs(in: VsOut) -> @location(0) vec4<f32> {
+    let g = textureLoad(g_position, vec2<i32>(in.clip.xy), 0);
+    if g.w < 0.0 {
+        discard;
+    }
+    let e = edges[in.edge];
+    return vec4<f32>(0.0, edge_term(g.xyz, e.v0.xyz, e.v1.xyz), 0.0, 0.0);
+}
