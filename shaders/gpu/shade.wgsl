@@ -1,13 +1,14 @@
 // requires: gpu/brdf.wgsl gpu/sh9.wgsl gpu/fullscreen.wgsl
-// Shading pass: per pixel, the G-buffer surface lit by distant cone lights (as directional
-// lights carrying the cone's irradiance) and point lights, each times its visibility layer, plus
-// SH9 ambient on the diffuse lobe, as `ref-tracer`'s `lights` integrator; misses see the map.
+// Shading pass: per pixel, the G-buffer surface lit by distant cone lights (the diffuse lobe by
+// the cone's exact irradiance, a GGX lobe by its representative point) and point lights, each
+// times its visibility layer, plus SH9 ambient on the diffuse lobe, as `ref-tracer`'s `lights`
+// integrator; misses see the map.
 
 struct Light {
     // xyz: unit direction towards a distant light, or a point light's position; w: 0 distant, 1 point
     position_or_direction: vec4<f32>,
     // rgb: a distant light's irradiance at normal incidence (radiance x solid angle), or a point
-    // light's intensity (W/sr)
+    // light's intensity (W/sr); w: a distant light's half-angle (radians; 0 directional)
     value: vec4<f32>,
 }
 
@@ -63,6 +64,67 @@ fn background_radiance(dir: vec3<f32>) -> vec3<f32> {
     return mix(top, bottom, fy);
 }
 
+// Integral of cos over the part of a cone (half-angle with sin^2 = `sin2`) above the surface,
+// the cone's axis at cos theta = `cos_t` from the normal: pi sin^2 cos theta while the cone is
+// wholly above the horizon, else the closed form for a uniform sphere or disk light (Snyder
+// 1996, as Frostbite writes it).
+fn cone_cosine_integral(cos_t: f32, sin2: f32) -> f32 {
+    if cos_t * cos_t > sin2 {
+        return PI * sin2 * max(cos_t, 0.0);
+    }
+    let sin_t = sqrt(max(1.0 - cos_t * cos_t, 1e-12));
+    let x = sqrt(max(1.0 / sin2 - 1.0, 0.0));
+    let y = clamp(-x * cos_t / sin_t, -1.0, 1.0);
+    let sin_t_sqrt_y = sin_t * sqrt(max(1.0 - y * y, 0.0));
+    return max((cos_t * acos(y) - x * sin_t_sqrt_y) * sin2 + atan2(sin_t_sqrt_y, x), 0.0);
+}
+
+// A cone light (unit axis `axis`, half-angle `half`, radiance x solid angle `e`) on material `m`.
+fn cone_light(m: Material, n: vec3<f32>, ng: vec3<f32>, wo: vec3<f32>, axis: vec3<f32>, half: f32, e: vec3<f32>) -> vec3<f32> {
+    let cos_o = dot(n, wo);
+    if cos_o <= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let sin_h = sin(half);
+    let cos_h = cos(half);
+    let solid_angle = 2.0 * PI * (1.0 - cos_h);
+    let radiance = e / max(solid_angle, 1e-30);
+    let integral = cone_cosine_integral(dot(n, axis), sin_h * sin_h);
+    if integral <= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    if m.albedo.a < 0.5 {
+        return m.albedo.rgb / PI * radiance * integral;
+    }
+    // coupled diffuse at the cone's mean cosine over the surface
+    let mean_cos = clamp(integral / max(solid_angle, 1e-30), 0.0, 1.0);
+    let f0 = m.f0_roughness.rgb;
+    var l = m.albedo.rgb * (vec3<f32>(1.0) - f0) * (28.0 / (23.0 * PI) * as_k(mean_cos) * as_k(cos_o)) * radiance * integral;
+    // specular: the cone's direction closest to the mirror direction
+    let r = reflect(-wo, n);
+    var d = r;
+    let c = dot(r, axis);
+    if c < cos_h {
+        let t = r - axis * c;
+        let tl = length(t);
+        d = select(axis, normalize(axis * cos_h + (t / max(tl, 1e-30)) * sin_h), tl > 1e-6);
+    }
+    let cos_i = dot(n, d);
+    if cos_i <= 0.0 || dot(ng, d) <= 0.0 {
+        return l;
+    }
+    let alpha = max(m.f0_roughness.a * m.f0_roughness.a, MIN_ALPHA);
+    // the lobe widened by the cone keeps its energy (Karis 2013's sphere-light normalization)
+    let widened = min(alpha + 0.5 * tan(min(half, 1.5)), 1.0);
+    let norm = (alpha / widened) * (alpha / widened);
+    let hs = wo + d;
+    let h = hs / max(length(hs), 1e-30);
+    let g2 = 1.0 / (1.0 + ggx_lambda(cos_o, alpha) + ggx_lambda(cos_i, alpha));
+    let spec = ggx_d(dot(n, h), alpha) * g2 / (4.0 * cos_o * cos_i);
+    l += fresnel_schlick(f0, dot(wo, h)) * spec * cos_i * e * norm;
+    return l;
+}
+
 @fragment
 fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let pixel = vec2<i32>(frag.xy);
@@ -80,6 +142,16 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
         let light = lights[k];
         var wi = light.position_or_direction.xyz;
         var e = light.value.rgb;
+        let half = light.value.w;
+        if light.position_or_direction.w < 0.5 && half > 1e-3 {
+            // any part of the cone above the geometric surface lights it
+            if dot(wi, ng) <= -sin(half) {
+                continue;
+            }
+            let v = textureLoad(visibility, pixel, k, 0).r;
+            l += cone_light(m, n, ng, wo, wi, half, e) * v;
+            continue;
+        }
         if light.position_or_direction.w > 0.5 {
             let d = wi - p.xyz;
             let d2 = max(dot(d, d), 1e-12);

@@ -1,5 +1,6 @@
-// Penumbra wedges: per pixel of an edge's conservative footprint, the edge's signed coverage
-// of the light's disk seen from the G-buffer point, a_e / pi, added to the accumulator's g
+// Penumbra wedges: per pixel of a footprint (the conservative hull of a few consecutive
+// silhouette edges' wedges), each edge's signed coverage of the light's disk seen from the
+// G-buffer point, a_e / pi, summed and added to the accumulator's g
 // (`penumbra_wedge::coverage` is the same computation on the CPU; its doc derives it).
 
 struct Light {
@@ -23,14 +24,17 @@ const MAX_HALF_ANGLE: f32 = 1.5;
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
-    @location(0) @interpolate(flat) edge: u32,
+    // the footprint's edges: first index and count
+    @location(0) @interpolate(flat) first: u32,
+    @location(1) @interpolate(flat) count: u32,
 }
 
 @vertex
-fn vs(@location(0) ndc: vec2<f32>, @location(1) edge: u32) -> VsOut {
+fn vs(@location(0) ndc: vec2<f32>, @location(1) first: u32, @location(2) count: u32) -> VsOut {
     var out: VsOut;
     out.clip = vec4<f32>(ndc, 0.5, 1.0);
-    out.edge = edge;
+    out.first = first;
+    out.count = count;
     return out;
 }
 
@@ -61,57 +65,68 @@ fn segment_term(q0: vec2<f32>, q1: vec2<f32>) -> f32 {
     return (g_term(h, dot(q1, s_hat)) - g_term(h, dot(q0, s_hat))) / PI;
 }
 
-fn edge_term(p: vec3<f32>, v0: vec3<f32>, v1: vec3<f32>) -> f32 {
-    var z: vec3<f32>;
+// The light seen from a receiver: its frame (z towards the centre), tan of its half-angle, and
+// the farthest z that still occludes it.
+struct LightFrame {
+    x: vec3<f32>,
+    y: vec3<f32>,
+    z: vec3<f32>,
+    tan_a: f32,
+    z_max: f32,
+}
+
+fn light_frame(p: vec3<f32>) -> LightFrame {
+    var f: LightFrame;
     var alpha: f32;
-    var z_max = 3.0e38;
+    f.z_max = 3.0e38;
     if light.config.x < 0.5 {
-        z = light.position_or_direction.xyz;
+        f.z = light.position_or_direction.xyz;
         alpha = light.config.y;
     } else {
         let to_c = light.position_or_direction.xyz - p;
         let dist = length(to_c);
-        z = to_c / max(dist, 1e-30);
+        f.z = to_c / max(dist, 1e-30);
         alpha = select(asin(min(light.config.y / dist, 1.0)), PI * 0.5, dist <= light.config.y);
-        z_max = dist * cos(alpha) * cos(alpha);
+        f.z_max = dist * cos(alpha) * cos(alpha);
     }
     alpha = clamp(alpha, 1e-7, MAX_HALF_ANGLE);
-    let helper = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(z.x) > 0.9);
-    let x = normalize(cross(helper, z));
-    let y = cross(z, x);
-    let tan_a = tan(alpha);
+    let helper = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(f.z.x) > 0.9);
+    f.x = normalize(cross(helper, f.z));
+    f.y = cross(f.z, f.x);
+    f.tan_a = tan(alpha);
+    return f;
+}
+
+fn edge_term(p: vec3<f32>, f: LightFrame, v0: vec3<f32>, v1: vec3<f32>) -> f32 {
     let d0 = v0 - p;
     let d1 = v1 - p;
-    let z0 = dot(d0, z);
-    let z1 = dot(d1, z);
+    let z0 = dot(d0, f.z);
+    let z1 = dot(d1, f.z);
     let z_min = 1e-6 * max(length(d0), length(d1));
+    if (z0 < z_min && z1 < z_min) || (z0 > f.z_max && z1 > f.z_max) {
+        return 0.0;
+    }
     // clip to z_min <= z <= z_max
     var t0 = 0.0;
     var t1 = 1.0;
     let dz = z1 - z0;
-    if z0 < z_min && z1 < z_min {
-        return 0.0;
-    }
     if z0 < z_min {
         t0 = clamp((z_min - z0) / dz, 0.0, 1.0);
     } else if z1 < z_min {
         t1 = clamp((z_min - z0) / dz, 0.0, 1.0);
     }
-    if z0 > z_max && z1 > z_max {
-        return 0.0;
-    }
-    if z0 > z_max {
-        t0 = max(t0, clamp((z_max - z0) / dz, 0.0, 1.0));
-    } else if z1 > z_max {
-        t1 = min(t1, clamp((z_max - z0) / dz, 0.0, 1.0));
+    if z0 > f.z_max {
+        t0 = max(t0, clamp((f.z_max - z0) / dz, 0.0, 1.0));
+    } else if z1 > f.z_max {
+        t1 = min(t1, clamp((f.z_max - z0) / dz, 0.0, 1.0));
     }
     if t0 >= t1 {
         return 0.0;
     }
     let a = d0 + (d1 - d0) * t0;
     let b = d0 + (d1 - d0) * t1;
-    let qa = vec2<f32>(dot(a, x), dot(a, y)) / (max(dot(a, z), z_min) * tan_a);
-    let qb = vec2<f32>(dot(b, x), dot(b, y)) / (max(dot(b, z), z_min) * tan_a);
+    let qa = vec2<f32>(dot(a, f.x), dot(a, f.y)) / (max(dot(a, f.z), z_min) * f.tan_a);
+    let qb = vec2<f32>(dot(b, f.x), dot(b, f.y)) / (max(dot(b, f.z), z_min) * f.tan_a);
     return segment_term(qa, qb);
 }
 
@@ -121,6 +136,11 @@ fn fs(in: VsOut) -> @location(0) vec4<f32> {
     if g.w < 0.0 {
         discard;
     }
-    let e = edges[in.edge];
-    return vec4<f32>(0.0, edge_term(g.xyz, e.v0.xyz, e.v1.xyz), 0.0, 0.0);
+    let f = light_frame(g.xyz);
+    var sum = 0.0;
+    for (var k = in.first; k < in.first + in.count; k++) {
+        let e = edges[k];
+        sum += edge_term(g.xyz, f, e.v0.xyz, e.v1.xyz);
+    }
+    return vec4<f32>(0.0, sum, 0.0, 0.0);
 }

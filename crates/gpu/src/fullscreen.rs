@@ -12,6 +12,17 @@ pub fn pipeline(
     module: &wgpu::ShaderModule,
     format: wgpu::TextureFormat,
 ) -> wgpu::RenderPipeline {
+    pipeline_with_target(gpu, label, module, format.into())
+}
+
+/// As [`pipeline`] with a full colour target state (blending, e.g. into an accumulator).
+#[must_use]
+pub fn pipeline_with_target(
+    gpu: &Gpu,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    target: wgpu::ColorTargetState,
+) -> wgpu::RenderPipeline {
     gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
         layout: None,
@@ -28,7 +39,7 @@ pub fn pipeline(
             module,
             entry_point: Some("fs"),
             compilation_options: Default::default(),
-            targets: &[Some(format.into())],
+            targets: &[Some(target)],
         }),
         multiview_mask: None,
         cache: None,

@@ -29,5 +29,7 @@ pub use geometry::{Chunk, SceneGeometry, ShadowGeometry, scene_triangles};
 pub use readback::{read_texture_f32, read_texture_rgba};
 pub use shade::{Background, HDR_FORMAT, ShadeLight, ShadeParams, ShadingPass, Visibility};
 pub use target::{layer_view, render_target};
-pub use technique::{LightShape, Receivers, ShadowPassReport, ShadowTechnique, render_visibility, totals};
+pub use technique::{
+    LightShape, PrecomputedVisibility, Receivers, ShadowPassReport, ShadowTechnique, render_visibility, totals,
+};
 pub use timer::Clock;

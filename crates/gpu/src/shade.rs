@@ -12,12 +12,18 @@ use wgpu::util::DeviceExt;
 /// A light as the shading pass sees it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ShadeLight {
-    /// A distant light, shaded as directional: its cone's irradiance from its centre direction.
+    /// A distant cone light of uniform radiance: the diffuse lobe gets the cone's exact
+    /// irradiance (the closed form for a uniform disk or sphere light, the part below the
+    /// surface's horizon left out), a GGX lobe its representative point (the cone's direction
+    /// closest to the mirror direction, with the lobe widened by the cone's size to keep its
+    /// energy). Half-angle 0 is a directional light.
     Distant {
         /// Unit direction towards the light.
         direction: Vec3,
         /// Irradiance at normal incidence: radiance × solid angle.
         irradiance: Vec3,
+        /// Half-angle of the cone, radians, in [0, pi/2].
+        half_angle: f32,
     },
     /// A point light.
     Point {
@@ -30,7 +36,11 @@ pub enum ShadeLight {
 
 impl From<&scene::DistantLight> for ShadeLight {
     fn from(l: &scene::DistantLight) -> Self {
-        ShadeLight::Distant { direction: l.direction, irradiance: l.radiance * l.solid_angle }
+        ShadeLight::Distant {
+            direction: l.direction,
+            irradiance: l.radiance * l.solid_angle,
+            half_angle: l.half_angle().min(std::f32::consts::FRAC_PI_2),
+        }
     }
 }
 
@@ -187,9 +197,9 @@ impl ShadingPass {
             .lights
             .iter()
             .map(|l| match *l {
-                ShadeLight::Distant { direction, irradiance } => LightUniform {
+                ShadeLight::Distant { direction, irradiance, half_angle } => LightUniform {
                     position_or_direction: direction.normalize_or_zero().extend(0.0).to_array(),
-                    value: irradiance.extend(0.0).to_array(),
+                    value: irradiance.extend(half_angle.clamp(0.0, std::f32::consts::FRAC_PI_2)).to_array(),
                 },
                 ShadeLight::Point { position, intensity } => LightUniform {
                     position_or_direction: position.extend(1.0).to_array(),

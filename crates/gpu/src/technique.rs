@@ -89,6 +89,9 @@ pub struct Receivers<'a> {
     pub points: &'a [(Vec3, Vec3)],
     /// Axis-aligned bounds of the finite points, `None` when the camera sees nothing.
     pub bounds: Option<(Vec3, Vec3)>,
+    /// Where most of what the camera sees is: the mean visible point and the 95th percentile of
+    /// distances to it (a shadow map spends its texels there; the far rest stays unshadowed).
+    pub focus: Option<(Vec3, f32)>,
 }
 
 impl<'a> Receivers<'a> {
@@ -100,7 +103,7 @@ impl<'a> Receivers<'a> {
             lo = lo.min(*p);
             hi = hi.max(*p);
         }
-        Self { gbuffer, points, bounds: lo.is_finite().then_some((lo, hi)) }
+        Self { gbuffer, points, bounds: lo.is_finite().then_some((lo, hi)), focus: view_focus(points) }
     }
 
     /// Whether any visible receiver has part of `light` above its surface: a light no receiver
@@ -109,6 +112,20 @@ impl<'a> Receivers<'a> {
     pub fn any_faces(&self, light: &LightShape) -> bool {
         self.points.iter().any(|(p, n)| p.is_finite() && light.reaches(*p, *n))
     }
+}
+
+/// Sphere around what the camera sees: the mean visible point and the 95th percentile of the
+/// distances to it.
+fn view_focus(points: &[(Vec3, Vec3)]) -> Option<(Vec3, f32)> {
+    let pts: Vec<Vec3> = points.iter().map(|(p, _)| *p).filter(|p| p.is_finite()).collect();
+    if pts.is_empty() {
+        return None;
+    }
+    let c = pts.iter().copied().sum::<Vec3>() / pts.len() as f32;
+    let mut d: Vec<f32> = pts.iter().map(|p| p.distance(c)).collect();
+    let k = (d.len() * 95 / 100).min(d.len() - 1);
+    let (_, r, _) = d.select_nth_unstable_by(k, f32::total_cmp);
+    Some((c, *r))
 }
 
 /// What one technique did for one light.
@@ -189,4 +206,81 @@ pub fn totals(reports: &[ShadowPassReport]) -> (Duration, usize, usize, u64) {
     let skipped = reports.iter().filter(|r| r.skipped.is_some()).count();
     let primitives = reports.iter().map(|r| r.primitives).sum();
     (time, reports.len() - skipped, skipped, primitives)
+}
+
+/// Visibility computed elsewhere (e.g. ray traced on the CPU) written into the layers: the
+/// technique whose shadows are the truth, so that a frame's remaining error is the shading's.
+pub struct PrecomputedVisibility {
+    name: String,
+    size: (u32, u32),
+    layers: Vec<(LightShape, Vec<f32>)>,
+    pipeline: wgpu::RenderPipeline,
+}
+
+impl PrecomputedVisibility {
+    /// `layers`: per light its per-pixel visibility, row-major, `size.0 × size.1` values.
+    ///
+    /// # Errors
+    /// [`GpuError::TooLarge`] when a layer's length is not the image's.
+    pub fn new(gpu: &Gpu, name: &str, size: (u32, u32), layers: Vec<(LightShape, Vec<f32>)>) -> Result<Self, GpuError> {
+        let pixels = u64::from(size.0) * u64::from(size.1);
+        if let Some((_, l)) = layers.iter().find(|(_, l)| l.len() as u64 != pixels) {
+            return Err(GpuError::TooLarge {
+                what: "visibility values for the image",
+                size: l.len() as u64,
+                limit: pixels,
+            });
+        }
+        let module =
+            crate::shader::module(&gpu.device, "upload", include_str!("../../../shaders/gpu/upload.wgsl"), &[]);
+        let pipeline = crate::fullscreen::pipeline(gpu, "upload", &module, Visibility::FORMAT);
+        Ok(Self { name: name.into(), size, layers, pipeline })
+    }
+}
+
+impl ShadowTechnique for PrecomputedVisibility {
+    fn name(&self) -> String {
+        self.name.clone()
+    }
+
+    fn supports(&self, light: &LightShape) -> bool {
+        self.layers.iter().any(|(l, _)| l == light)
+    }
+
+    fn write_visibility(
+        &self,
+        gpu: &Gpu,
+        receivers: &Receivers,
+        light: &LightShape,
+        target: &wgpu::TextureView,
+    ) -> Result<ShadowPassReport, GpuError> {
+        use wgpu::util::DeviceExt;
+        let Some((_, values)) = self.layers.iter().find(|(l, _)| l == light) else {
+            return Err(GpuError::Failed(format!("{}: no visibility for {light:?}", self.name)));
+        };
+        if receivers.gbuffer.size() != self.size {
+            return Err(GpuError::Failed(format!(
+                "{}: computed for {:?}, not {:?}",
+                self.name,
+                self.size,
+                receivers.gbuffer.size()
+            )));
+        }
+        let params = [self.size.0, self.size.1, 0, 0];
+        let buffer = |label, contents: &[u8], usage| {
+            gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+        };
+        let params = buffer("upload params", bytemuck::cast_slice(&params), wgpu::BufferUsages::UNIFORM);
+        let values = buffer("upload values", bytemuck::cast_slice(values), wgpu::BufferUsages::STORAGE);
+        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("upload"),
+            layout: &self.pipeline.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: values.as_entire_binding() },
+            ],
+        });
+        crate::fullscreen::draw(gpu, &self.pipeline, &bind, target, wgpu::Color::WHITE)?;
+        Ok(ShadowPassReport::default())
+    }
 }

@@ -119,6 +119,20 @@ impl Casters {
         }
         out
     }
+
+    /// The silhouette of each caster `keep` accepts, with the caster.
+    #[must_use]
+    pub fn silhouettes(&self, light: &LightShape, mut keep: impl FnMut(&Caster) -> bool) -> Vec<(&Caster, Silhouette)> {
+        self.casters
+            .iter()
+            .filter(|c| keep(c))
+            .map(|c| {
+                let mut s = Silhouette::default();
+                silhouette_of(c, light, &mut s);
+                (c, s)
+            })
+            .collect()
+    }
 }
 
 /// Whether a face with unit-free normal `n` through `a` faces the light's centre: > 0 faces,

@@ -27,7 +27,7 @@ pub fn extrude(x: Vec3, light: &LightShape, extent: f32) -> Option<Vec3> {
 }
 
 /// The hard shadow volume of `sil` from `light`'s centre: front cap (the lit faces), dark cap
-/// (them extruded, reversed) and a quad per silhouette edge, wound outward.
+/// (them extruded by `extent`, reversed) and a quad per silhouette edge, wound outward.
 #[must_use]
 pub fn shadow_volume(sil: &Silhouette, light: &LightShape, extent: f32) -> Vec<[Vec3; 3]> {
     let mut out = Vec::with_capacity(2 * sil.lit_faces.len() + 2 * sil.edges.len());
@@ -48,16 +48,80 @@ pub fn shadow_volume(sil: &Silhouette, light: &LightShape, extent: f32) -> Vec<[
     out
 }
 
-/// The 18 points whose convex hull contains edge `[v0, v1]`'s wedge out to `extent`, or `None`
-/// when an endpoint is within the light (a local light's edge that close is skipped).
+/// The interval of t >= 0 where `origin + axis t` lies in the box `(lo, hi)` (slab test),
+/// `None` when the ray misses it.
 #[must_use]
-pub fn wedge_hull_points(v0: Vec3, v1: Vec3, light: &LightShape, extent: f32) -> Option<Vec<Vec3>> {
+pub fn box_interval(origin: Vec3, axis: Vec3, (lo, hi): (Vec3, Vec3)) -> Option<(f32, f32)> {
+    let (mut t0, mut t1) = (0.0f32, f32::INFINITY);
+    for k in 0..3 {
+        if axis[k].abs() < 1e-20 {
+            if origin[k] < lo[k] || origin[k] > hi[k] {
+                return None;
+            }
+        } else {
+            let (a, b) = ((lo[k] - origin[k]) / axis[k], (hi[k] - origin[k]) / axis[k]);
+            t0 = t0.max(a.min(b));
+            t1 = t1.min(a.max(b));
+        }
+    }
+    (t0 <= t1).then_some((t0, t1))
+}
+
+/// Where a ray `origin + axis t` (t >= 0) leaves the box: the largest t inside it, `None` when
+/// it never enters.
+#[must_use]
+pub fn box_exit(origin: Vec3, axis: Vec3, bounds: (Vec3, Vec3)) -> Option<f32> {
+    box_interval(origin, axis, bounds).map(|(_, t1)| t1)
+}
+
+/// How far along `axis` a cone of half-angle tangent `tan` from any apex within `radius` of
+/// `centre` can still meet the box `receivers`, at most `extent`: a point of the cone at axial
+/// distance t lies within t tan of the axis, so its axis point lies in the box grown by that;
+/// iterating the exit parameter of the grown box from `extent` down stays conservative.
+/// `None` when it cannot meet the box at all.
+#[must_use]
+pub fn reach_along(
+    centre: Vec3,
+    radius: f32,
+    axis: Vec3,
+    tan: f32,
+    receivers: (Vec3, Vec3),
+    extent: f32,
+) -> Option<f32> {
+    let mut l = extent;
+    for _ in 0..4 {
+        let grow = Vec3::splat(radius + l * tan);
+        let exit = box_exit(centre, axis, (receivers.0 - grow, receivers.1 + grow))?;
+        if exit >= l {
+            break;
+        }
+        l = exit;
+    }
+    Some(l.max(0.0))
+}
+
+/// The 18 points whose convex hull contains edge `[v0, v1]`'s wedge out to `extent`, or `None`
+/// when an endpoint is within the light (a local light's edge that close is skipped). With
+/// `receivers`, a distant light's wedge stops where it can no longer meet them.
+#[must_use]
+pub fn wedge_hull_points(
+    v0: Vec3,
+    v1: Vec3,
+    light: &LightShape,
+    extent: f32,
+    receivers: Option<(Vec3, Vec3)>,
+) -> Option<Vec<Vec3>> {
     // (apex, axis away from the light, half-angle, axial length)
     let cones: [(Vec3, Vec3, f32, f32); 2] = match *light {
         LightShape::Distant { direction, half_angle } => {
             let a = -direction.normalize_or(Vec3::Y);
             let h = half_angle.clamp(0.0, LightShape::MAX_HALF_ANGLE);
-            [(v0, a, h, extent), (v1, a, h, extent)]
+            // one length for both cones, from the edge's bounding sphere (the convexity
+            // argument needs equal lengths; a bound at the endpoints alone would not hold inside)
+            let len = receivers.map_or(Some(extent), |rb| {
+                reach_along(0.5 * (v0 + v1), 0.5 * v0.distance(v1), a, h.tan(), rb, extent)
+            })?;
+            [(v0, a, h, len), (v1, a, h, len)]
         }
         LightShape::Sphere { center, radius } => {
             let (d0, d1) = (v0.distance(center), v1.distance(center));
@@ -98,31 +162,82 @@ pub fn points_meet_box(points: &[Vec3], (lo, hi): (Vec3, Vec3)) -> bool {
     plo.cmple(hi).all() && phi.cmpge(lo).all()
 }
 
-/// The screen footprint (NDC triangles) of the convex hull of `points` under `view_proj`: the
-/// whole screen when a point is at or behind the eye's plane, nothing when it lies off screen.
+/// The screen footprint (NDC triangles) of the convex hull of `points` under `view_proj`,
+/// clipped to view depths of at least `near` (no receiver is nearer) and to the screen; nothing
+/// when it lies off screen or behind the eye. Clipping a convex hull by a plane keeps the points
+/// in front and the crossings of every segment between a point in front and one behind.
 #[must_use]
-pub fn footprint(points: &[Vec3], view_proj: &Mat4) -> Vec<[Vec2; 3]> {
-    let full = vec![
-        [Vec2::new(-1.0, -1.0), Vec2::new(1.0, -1.0), Vec2::new(1.0, 1.0)],
-        [Vec2::new(-1.0, -1.0), Vec2::new(1.0, 1.0), Vec2::new(-1.0, 1.0)],
-    ];
-    let mut ndc = Vec::with_capacity(points.len());
-    for p in points {
-        let c = *view_proj * p.extend(1.0);
-        let w_min = 1e-6 * c.xyz().length().max(1e-30);
-        if c.w.is_nan() || c.w <= w_min {
-            return full;
+pub fn footprint(points: &[Vec3], view_proj: &Mat4, near: f32) -> Vec<[Vec2; 3]> {
+    let clip: Vec<glam::Vec4> = points.iter().map(|p| *view_proj * p.extend(1.0)).collect();
+    let (front, back): (Vec<glam::Vec4>, Vec<glam::Vec4>) = clip.iter().partition(|c| c.w >= near);
+    let mut ndc: Vec<Vec2> = front.iter().map(|c| c.xy() / c.w).collect();
+    for f in &front {
+        for b in &back {
+            let t = (f.w - near) / (f.w - b.w);
+            let c = *f + (*b - *f) * t;
+            ndc.push(c.xy() / near);
         }
-        ndc.push(c.xy() / c.w);
     }
-    let hull = convex_hull(ndc);
-    let (lo, hi) = hull
-        .iter()
-        .fold((Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY)), |(a, b), p| (a.min(*p), b.max(*p)));
-    if hull.len() < 3 || lo.x > 1.0 || lo.y > 1.0 || hi.x < -1.0 || hi.y < -1.0 {
+    let hull = clip_to_screen(&convex_hull(ndc));
+    if hull.len() < 3 {
         return Vec::new();
     }
     (1..hull.len() - 1).map(|k| [hull[0], hull[k], hull[k + 1]]).collect()
+}
+
+/// A convex polygon clipped to the screen square [-1, 1]² (Sutherland-Hodgman).
+fn clip_to_screen(poly: &[Vec2]) -> Vec<Vec2> {
+    let mut out = poly.to_vec();
+    for (axis, sign) in [(0, 1.0f32), (0, -1.0), (1, 1.0), (1, -1.0)] {
+        if out.is_empty() {
+            break;
+        }
+        // keep sign * p[axis] <= 1
+        let inside = |p: Vec2| sign * p[axis] <= 1.0;
+        let input = std::mem::take(&mut out);
+        for k in 0..input.len() {
+            let (a, b) = (input[k], input[(k + 1) % input.len()]);
+            if inside(a) {
+                out.push(a);
+            }
+            if inside(a) != inside(b) {
+                let t = (sign - a[axis]) / (b[axis] - a[axis]);
+                out.push(a + (b - a) * t);
+            }
+        }
+    }
+    out
+}
+
+/// Silhouette edges ordered into chains (each edge's end is the next one's start where the
+/// silhouette continues), so that neighbouring edges can share one footprint.
+#[must_use]
+pub fn chains(edges: &[[Vec3; 2]]) -> Vec<Vec<[Vec3; 2]>> {
+    let key = |p: Vec3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+    let mut by_start: std::collections::HashMap<[u32; 3], Vec<usize>> = std::collections::HashMap::new();
+    for (k, e) in edges.iter().enumerate() {
+        by_start.entry(key(e[0])).or_default().push(k);
+    }
+    let mut used = vec![false; edges.len()];
+    let mut out = Vec::new();
+    for first in 0..edges.len() {
+        if used[first] {
+            continue;
+        }
+        let mut chain = Vec::new();
+        let mut k = first;
+        loop {
+            used[k] = true;
+            chain.push(edges[k]);
+            let next = by_start.get(&key(edges[k][1])).and_then(|c| c.iter().copied().find(|&j| !used[j]));
+            match next {
+                Some(j) => k = j,
+                None => break,
+            }
+        }
+        out.push(chain);
+    }
+    out
 }
 
 /// Andrew's monotone chain: the convex hull of `pts`, counter-clockwise, without collinear
@@ -177,6 +292,51 @@ mod tests {
     }
 
     #[test]
+    fn cube_silhouette_is_one_closed_chain() {
+        let m = scene::Mesh::cuboid(Vec3::ZERO, Vec3::ONE);
+        let casters = Casters { casters: vec![Caster::new("box", &m.positions, &m.indices)] };
+        let light = LightShape::Distant { direction: Vec3::new(0.3, 1.0, 0.2).normalize(), half_angle: 0.05 };
+        let sil = casters.silhouette(&light, |_| true);
+        let c = chains(&sil.edges);
+        assert_eq!(c.len(), 1);
+        assert_eq!(c[0].len(), sil.edges.len());
+        for k in 0..c[0].len() {
+            assert_eq!(c[0][k][1], c[0][(k + 1) % c[0].len()][0], "edge {k} ends where the next starts");
+        }
+    }
+
+    #[test]
+    fn footprint_behind_the_eye_is_clipped_not_the_whole_screen() {
+        let camera = scene::Camera {
+            eye: Vec3::new(0.0, 1.0, 5.0),
+            target: Vec3::ZERO,
+            up: Vec3::Y,
+            hfov_degrees: 60.0,
+            width: 64,
+            height: 48,
+        };
+        let vp = gpu::view_projection_infinite(&camera, 0.01);
+        // a thin slab from in front of the eye to behind it, off to the left
+        let pts = [
+            Vec3::new(-1.5, 0.0, 0.0),
+            Vec3::new(-1.5, 0.2, 0.0),
+            Vec3::new(-1.5, 0.0, 10.0),
+            Vec3::new(-1.5, 0.2, 10.0),
+        ];
+        let tris = footprint(&pts, &vp, 0.01);
+        let area: f32 = tris.iter().map(|t| 0.5 * (t[1] - t[0]).perp_dot(t[2] - t[0]).abs()).sum();
+        assert!(area > 0.0 && area < 2.0, "area {area} of the screen's 4");
+        for t in &tris {
+            for v in t {
+                assert!(v.x <= -0.0 && v.abs().max_element() <= 1.0 + 1e-5, "{v}");
+            }
+        }
+        // wholly behind the eye: nothing
+        let behind: Vec<Vec3> = pts.iter().map(|p| *p + Vec3::Z * 20.0).collect();
+        assert!(footprint(&behind, &vp, 0.01).is_empty());
+    }
+
+    #[test]
     fn hull_is_counter_clockwise_and_convex() {
         let pts = vec![Vec2::ZERO, Vec2::X, Vec2::Y, Vec2::ONE, Vec2::splat(0.5), Vec2::new(0.5, 0.0)];
         let h = convex_hull(pts);
@@ -193,7 +353,7 @@ mod tests {
             LightShape::Sphere { center: Vec3::new(0.5, 4.0, 0.5), radius: 0.8 },
         ];
         for light in lights {
-            let pts = wedge_hull_points(v0, v1, &light, 20.0).expect("outside the light");
+            let pts = wedge_hull_points(v0, v1, &light, 20.0, None).expect("outside the light");
             // random points p: where an edge point x seen from p lies within the light, p must
             // be inside the hull (checked against its faces by a 3-D support test per
             // direction: p's projection on any direction does not exceed the hull's)

@@ -27,6 +27,7 @@ pub mod coverage;
 pub mod geometry;
 
 use casters::{Caster, Casters};
+use geometry::reach_along;
 use glam::{Mat4, Vec3};
 use gpu::accumulate::{Accumulator, Resolve, ResolvePass};
 use gpu::{Gpu, GpuError, LightShape, Receivers, ShadowPassReport, ShadowTechnique};
@@ -38,11 +39,15 @@ pub struct WedgeSettings {
     /// Draw only casters whose shadow can reach a visible receiver, and only wedges that can
     /// reach one and lie on screen (off: everything, for measuring what culling saves).
     pub cull: bool,
+    /// Consecutive silhouette edges drawn under one footprint (the hull of their wedges): fewer,
+    /// larger footprints, each pixel looping over the group's edges. 1 is one wedge per edge.
+    pub edges_per_footprint: u32,
 }
 
 impl Default for WedgeSettings {
+    /// Culling on, 8 edges per footprint.
     fn default() -> Self {
-        Self { cull: true }
+        Self { cull: true, edges_per_footprint: 8 }
     }
 }
 
@@ -53,8 +58,8 @@ pub struct WedgePlan {
     pub volume: Vec<[Vec3; 3]>,
     /// Silhouette edges with a wedge to draw.
     pub edges: Vec<[Vec3; 2]>,
-    /// Footprint triangles in NDC with the index of their edge in `edges`.
-    pub footprints: Vec<([glam::Vec2; 3], u32)>,
+    /// Footprint triangles in NDC with the range of their edges in `edges` (first, count).
+    pub footprints: Vec<([glam::Vec2; 3], u32, u32)>,
     /// Work left out, as `(what, how many)`.
     pub culled: Vec<(&'static str, u64)>,
 }
@@ -73,7 +78,8 @@ pub struct Wedges {
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct FootprintVertex {
     ndc: [f32; 2],
-    edge: u32,
+    first: u32,
+    count: u32,
 }
 
 #[repr(C)]
@@ -83,22 +89,9 @@ struct ViewUniform {
     eye: [f32; 4],
 }
 
-/// Whether the segment from `a` to `b` meets the box `(lo, hi)` (slab test).
-fn segment_meets_box(a: Vec3, b: Vec3, (lo, hi): (Vec3, Vec3)) -> bool {
-    let d = b - a;
-    let (mut t0, mut t1) = (0.0f32, 1.0f32);
-    for k in 0..3 {
-        if d[k].abs() < 1e-30 {
-            if a[k] < lo[k] || a[k] > hi[k] {
-                return false;
-            }
-        } else {
-            let (ta, tb) = ((lo[k] - a[k]) / d[k], (hi[k] - a[k]) / d[k]);
-            t0 = t0.max(ta.min(tb));
-            t1 = t1.min(ta.max(tb));
-        }
-    }
-    t0 <= t1
+/// Whether the segment from `a` to `b` meets the box `(lo, hi)`.
+fn segment_meets_box(a: Vec3, b: Vec3, bounds: (Vec3, Vec3)) -> bool {
+    geometry::box_interval(a, b - a, bounds).is_some_and(|(t0, _)| t0 <= 1.0)
 }
 
 /// Whether any shadow of `caster` from `light` can land in `receivers` within `extent`: its
@@ -173,7 +166,7 @@ impl Wedges {
             wgpu::VertexBufferLayout {
                 array_stride: std::mem::size_of::<FootprintVertex>() as u64,
                 step_mode: wgpu::VertexStepMode::Vertex,
-                attributes: &wgpu::vertex_attr_array![0 => Float32x2, 1 => Uint32],
+                attributes: &wgpu::vertex_attr_array![0 => Float32x2, 1 => Uint32, 2 => Uint32],
             },
         );
         Self { casters, bounds: (lo, hi), settings, volume, wedge, resolve: ResolvePass::new(gpu) }
@@ -202,32 +195,59 @@ impl Wedges {
         let mut plan = WedgePlan::default();
         let Some(rb) = receivers else { return plan };
         let extent = self.extent(receivers);
+        // nearer than this no receiver can be (the G-buffer's near plane is farther)
+        let near = extent * 1e-7;
         let cull = self.settings.cull;
         let mut casters_culled = 0u64;
-        let sil = self.casters.silhouette(light, |c| {
+        let sils = self.casters.silhouettes(light, |c| {
             let keep = !cull || shadow_can_reach(c, light, rb, extent);
             casters_culled += u64::from(!keep);
             keep
         });
-        plan.volume = geometry::shadow_volume(&sil, light, extent);
         let (mut at_light, mut away) = (0u64, 0u64);
-        for &[a, b] in &sil.edges {
-            let Some(points) = geometry::wedge_hull_points(a, b, light, extent) else {
-                at_light += 1;
-                continue;
+        for (caster, sil) in &sils {
+            // a distant light's volume ends where no receiver can be (from the caster's
+            // bounding sphere); local lights' volumes keep the scene's extent
+            let length = match *light {
+                LightShape::Distant { direction, .. } if cull => {
+                    let (c, r) = caster.bounds;
+                    reach_along(c, r, -direction.normalize_or(Vec3::Y), 0.0, rb, extent).unwrap_or(0.0).max(r * 1e-3)
+                        + r
+                }
+                _ => extent,
             };
-            if cull && !geometry::points_meet_box(&points, rb) {
-                away += 1;
-                continue;
+            plan.volume.extend(geometry::shadow_volume(sil, light, length));
+            for chain in geometry::chains(&sil.edges) {
+                for group in chain.chunks(self.settings.edges_per_footprint.max(1) as usize) {
+                    let mut points = Vec::with_capacity(18 * group.len());
+                    let mut edges = Vec::with_capacity(group.len());
+                    for &[a, b] in group {
+                        match geometry::wedge_hull_points(a, b, light, extent, cull.then_some(rb)) {
+                            Some(p) => {
+                                points.extend(p);
+                                edges.push([a, b]);
+                            }
+                            None => at_light += 1,
+                        }
+                    }
+                    if edges.is_empty() {
+                        continue;
+                    }
+                    let tris = if cull && !geometry::points_meet_box(&points, rb) {
+                        Vec::new()
+                    } else {
+                        geometry::footprint(&points, view_proj, near)
+                    };
+                    if tris.is_empty() {
+                        away += edges.len() as u64;
+                        continue;
+                    }
+                    let first = plan.edges.len() as u32;
+                    let count = edges.len() as u32;
+                    plan.edges.extend(edges);
+                    plan.footprints.extend(tris.into_iter().map(|t| (t, first, count)));
+                }
             }
-            let tris = geometry::footprint(&points, view_proj);
-            if tris.is_empty() {
-                away += 1;
-                continue;
-            }
-            let k = plan.edges.len() as u32;
-            plan.edges.push([a, b]);
-            plan.footprints.extend(tris.into_iter().map(|t| (t, k)));
         }
         plan.culled = vec![
             ("casters whose shadow cannot reach a visible receiver", casters_culled),
@@ -264,7 +284,9 @@ impl ShadowTechnique for Wedges {
         let footprints: Vec<FootprintVertex> = plan
             .footprints
             .iter()
-            .flat_map(|(t, k)| t.map(|v| FootprintVertex { ndc: v.to_array(), edge: *k }))
+            .flat_map(|(t, first, count)| {
+                t.map(|v| FootprintVertex { ndc: v.to_array(), first: *first, count: *count })
+            })
             .collect();
         let mut edges: Vec<[[f32; 4]; 2]> =
             plan.edges.iter().map(|[a, b]| [a.extend(1.0).to_array(), b.extend(1.0).to_array()]).collect();

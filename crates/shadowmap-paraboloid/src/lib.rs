@@ -24,8 +24,10 @@ pub mod cpu;
 mod mapper;
 pub mod paraboloid;
 pub mod subdivide;
+mod technique;
 
-pub use mapper::{ShadowMap, ShadowMapper, ShadowView};
+pub use mapper::{ShadowMap, ShadowMapper, ShadowView, VisibilityTarget};
+pub use technique::MapTechnique;
 
 use glam::Vec3;
 
@@ -98,6 +100,27 @@ pub struct ShadowSettings {
     /// what the camera sees; the map then spends its texels there (casters between it and the
     /// light still count). `None`: the whole scene.
     pub focus: Option<(Vec3, f32)>,
+    /// For orthographic maps of distant cone lights: percentage-closer soft shadows (blocker
+    /// search, penumbra from the light's angular size, variable filter) instead of `pcf_radius`.
+    pub pcss: Option<Pcss>,
+}
+
+/// Knobs of percentage-closer soft shadows (Fernando 2005, as Bevy and three.js ship them).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pcss {
+    /// Depth samples of the blocker search (Vogel disk).
+    pub blocker_samples: u32,
+    /// Lit tests of the filter (Vogel disk).
+    pub filter_samples: u32,
+    /// Largest search and filter radius, texels (the cost bound for wide lights).
+    pub max_radius_texels: f32,
+}
+
+impl Default for Pcss {
+    /// 16 blocker samples, 32 filter samples, radii up to 64 texels.
+    fn default() -> Self {
+        Self { blocker_samples: 16, filter_samples: 32, max_radius_texels: 64.0 }
+    }
 }
 
 impl Default for ShadowSettings {
@@ -114,6 +137,7 @@ impl Default for ShadowSettings {
             near: 0.01,
             subdivide_angle: Some(0.2),
             focus: None,
+            pcss: None,
         }
     }
 }

@@ -92,6 +92,17 @@ pub struct ShadowMapper {
     paraboloid_plain: wgpu::RenderPipeline,
     matrix: wgpu::RenderPipeline,
     visibility: wgpu::RenderPipeline,
+    // the same pass adding into a `gpu::accumulate::Accumulator` (N-sample maps)
+    visibility_add: wgpu::RenderPipeline,
+}
+
+/// Where a visibility pass writes.
+#[derive(Clone, Copy)]
+pub enum VisibilityTarget<'a> {
+    /// A visibility layer (R8Unorm), overwritten.
+    Layer(&'a wgpu::TextureView),
+    /// Added into an accumulator's r (cleared first when the flag says so).
+    Add(&'a gpu::accumulate::Accumulator, bool),
 }
 
 fn depth_pipeline(
@@ -220,6 +231,12 @@ impl ShadowMapper {
         };
         let module = gpu::shader::module(&gpu.device, "shadow visibility", src("visibility"), LIBRARY);
         let visibility = gpu::fullscreen::pipeline(gpu, "shadow visibility", &module, gpu::Visibility::FORMAT);
+        let visibility_add = gpu::fullscreen::pipeline_with_target(
+            gpu,
+            "shadow visibility (add)",
+            &module,
+            gpu::accumulate::Accumulator::target(gpu),
+        );
         let view_layout = gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shadow view"),
             entries: &[wgpu::BindGroupLayoutEntry {
@@ -247,6 +264,7 @@ impl ShadowMapper {
             matrix: depth_pipeline(gpu, &layout, "matrix depth", src("matrix"), false),
             view_layout,
             visibility,
+            visibility_add,
         }
     }
 
@@ -421,12 +439,31 @@ impl ShadowMapper {
         gbuffer: &GBuffer,
         target: &wgpu::TextureView,
     ) -> Result<(), GpuError> {
+        let mut encoder = gpu.encoder("shadow visibility");
+        self.record_visibility(gpu, &mut encoder, map, gbuffer, VisibilityTarget::Layer(target), 0.0);
+        gpu.submit_and_wait(encoder)
+    }
+
+    /// Records `map`'s visibility pass into `encoder`, writing a visibility layer or adding into
+    /// an accumulator (cleared first when asked). `half_angle` is the light's (radians), used by
+    /// PCSS (`settings.pcss`) on orthographic maps.
+    pub fn record_visibility(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        map: &ShadowMap,
+        gbuffer: &GBuffer,
+        target: VisibilityTarget<'_>,
+        half_angle: f32,
+    ) {
         #[repr(C)]
         #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
         struct Params {
             light: [f32; 4],
             forward: [f32; 4],
             config: [f32; 4],
+            pcss: [f32; 4],
+            pcss_limits: [f32; 4],
             views: [ViewUniform; 6],
         }
         let (light, kind) = match map.light {
@@ -443,10 +480,24 @@ impl ShadowMapper {
             *slot = v.uniform();
         }
         let forward = map.frame.map_or(Vec3::ZERO, |f| f.forward);
+        let (pcss, pcss_limits) = match map.settings.pcss {
+            Some(p) if map.technique == Technique::Orthographic => (
+                [
+                    1.0,
+                    half_angle.clamp(0.0, 1.5).tan(),
+                    p.blocker_samples.max(1) as f32,
+                    p.filter_samples.max(1) as f32,
+                ],
+                [p.max_radius_texels.max(1.0), 0.0, 0.0, 0.0],
+            ),
+            _ => ([0.0; 4], [0.0; 4]),
+        };
         let params = Params {
             light: light.extend(kind).to_array(),
             forward: forward.extend(0.0).to_array(),
             config: [technique, map.views.len() as f32, map.settings.pcf_radius as f32, map.settings.bias_texels],
+            pcss,
+            pcss_limits,
             views,
         };
         let buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -461,9 +512,13 @@ impl ShadowMapper {
             aspect: wgpu::TextureAspect::DepthOnly,
             ..Default::default()
         });
+        let pipeline = match target {
+            VisibilityTarget::Layer(_) => &self.visibility,
+            VisibilityTarget::Add(..) => &self.visibility_add,
+        };
         let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("visibility"),
-            layout: &self.visibility.get_bind_group_layout(0),
+            layout: &pipeline.get_bind_group_layout(0),
             entries: &[
                 wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&position) },
@@ -471,6 +526,22 @@ impl ShadowMapper {
                 wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&shadow) },
             ],
         });
-        gpu::fullscreen::draw(gpu, &self.visibility, &bind, target, wgpu::Color::WHITE)
+        let attachment = match target {
+            VisibilityTarget::Layer(view) => wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::WHITE), store: wgpu::StoreOp::Store },
+            },
+            VisibilityTarget::Add(acc, clear) => acc.attachment(clear),
+        };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("shadow visibility"),
+            color_attachments: &[Some(attachment)],
+            ..Default::default()
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &bind, &[]);
+        pass.draw(0..3, 0..1);
     }
 }

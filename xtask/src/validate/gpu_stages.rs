@@ -1,34 +1,32 @@
-//! The GPU stages of `validate`: the extracted lights with orthographic shadow maps on
-//! `spheres_box` (or the given scene), and the `room` point light's paraboloid and cube maps
-//! against ray-traced visibility.
+//! The GPU stages of `validate`: the extracted lights on `spheres_box` (or the given scene)
+//! shadowed by every technique (shadow maps, PCSS, N-sample maps, penumbra wedges) through
+//! `gpu::ShadowTechnique`, and the `room` point light's paraboloid and cube maps against
+//! ray-traced visibility.
 
 use super::{MaskRow, Plan};
 use envmap_sphere::EnvMap;
 use glam::Vec3;
 use gpu::{
-    Background, GBufferPass, Gpu, SceneGeometry, ShadeLight, ShadeParams, ShadingPass, ShadowGeometry, Visibility,
+    Background, GBufferPass, Gpu, LightShape, PrecomputedVisibility, Receivers, SceneGeometry, ShadeLight, ShadeParams,
+    ShadingPass, ShadowGeometry, ShadowTechnique, Visibility, render_visibility,
 };
+use penumbra_wedge::{WedgeSettings, Wedges};
 use ref_tracer::SceneBvh;
-use ref_tracer::visibility::{VisibilityLight, light_visibility};
+use ref_tracer::visibility::{AreaLight, VisibilityLight, area_light_visibility, light_visibility};
 use shadowmap_paraboloid::{
-    ShadowLight, ShadowMapper, ShadowSettings, Technique, disagreement, equal_texel_variants, shadow_triangles,
+    MapTechnique, Pcss, ShadowLight, ShadowMapper, ShadowSettings, Technique, disagreement, equal_texel_variants,
+    shadow_triangles,
 };
 use std::time::Instant;
 
-/// Sphere around what the camera sees: the mean visible position and the 95th percentile of
-/// distances to it (the rest, far away, is left unshadowed).
-fn view_focus(points: &[(Vec3, Vec3)]) -> Option<(Vec3, f32)> {
-    let pts: Vec<Vec3> = points.iter().map(|(p, _)| *p).filter(|p| p.is_finite()).collect();
-    if pts.is_empty() {
-        return None;
-    }
-    let c = pts.iter().copied().sum::<Vec3>() / pts.len() as f32;
-    let mut d: Vec<f32> = pts.iter().map(|p| p.distance(c)).collect();
-    d.sort_by(f32::total_cmp);
-    Some((c, d[(d.len() * 95 / 100).min(d.len() - 1)]))
+/// One GPU image: its row name, what it is (technique, lights shadowed and skipped, GPU time),
+/// the image and the seconds it took end to end.
+pub(super) struct GpuImage {
+    pub(super) name: String,
+    pub(super) what: String,
+    pub(super) image: Vec<Vec3>,
+    pub(super) seconds: f64,
 }
-
-pub(super) type GpuImages = (Vec<Vec3>, Vec<Vec3>, f64, f64);
 
 /// The GPU passes, built once per run.
 pub(super) struct Passes {
@@ -37,6 +35,60 @@ pub(super) struct Passes {
     pub(super) shading: ShadingPass,
 }
 
+/// Ray-traced visibility of each light from the G-buffer's points (`n` × `n` stratified
+/// directions per pixel; pixels the light cannot reach stay lit).
+fn traced_visibility(
+    gpu: &Gpu,
+    scene: &scene::Scene,
+    receivers: &Receivers,
+    shapes: &[LightShape],
+    n: u32,
+) -> Result<PrecomputedVisibility, String> {
+    let bvh = SceneBvh::new(scene);
+    let layers = shapes
+        .iter()
+        .map(|s| {
+            let LightShape::Distant { direction, half_angle } = *s else {
+                unreachable!("extracted lights are distant")
+            };
+            let v = area_light_visibility(&bvh, receivers.points, AreaLight::Cone { direction, half_angle }, n);
+            (*s, v.into_iter().map(|v| v.unwrap_or(1.0)).collect())
+        })
+        .collect();
+    PrecomputedVisibility::new(
+        gpu,
+        &format!("ray-traced visibility ({n}x{n} directions)"),
+        receivers.gbuffer.size(),
+        layers,
+    )
+    .map_err(|e| e.to_string())
+}
+
+/// A row name and its shadow technique.
+type NamedTechnique = (String, Box<dyn ShadowTechnique>);
+
+/// The shadow techniques validate compares on the extracted lights, by row name.
+fn techniques(gpu: &Gpu, scene: &scene::Scene, plan: &Plan) -> Result<Vec<NamedTechnique>, String> {
+    let e = |e: gpu::GpuError| e.to_string();
+    let hard = plan.shadow;
+    let pcss = ShadowSettings { pcss: Some(Pcss::default()), pcf_radius: 0, ..hard };
+    let multi = ShadowSettings { resolution: hard.resolution / 2, pcf_radius: 0, ..hard };
+    Ok(vec![
+        (
+            "gpu_shadow_maps".into(),
+            Box::new(MapTechnique::new(gpu, scene, Technique::Orthographic, hard, 1).map_err(e)?),
+        ),
+        ("gpu_pcss".into(), Box::new(MapTechnique::new(gpu, scene, Technique::Orthographic, pcss, 1).map_err(e)?)),
+        (
+            format!("gpu_shadow_maps_x{}", plan.multi_samples),
+            Box::new(MapTechnique::new(gpu, scene, Technique::Orthographic, multi, plan.multi_samples).map_err(e)?),
+        ),
+        ("gpu_wedges".into(), Box::new(Wedges::new(gpu, scene, WedgeSettings::default()))),
+    ])
+}
+
+/// The extracted lights on the GPU with every technique of [`techniques`], and without shadows
+/// (the last image).
 pub(super) fn gpu_render(
     gpu: &Gpu,
     passes: &Passes,
@@ -44,39 +96,53 @@ pub(super) fn gpu_render(
     map: &EnvMap,
     d: &light_extract::Decomposition,
     plan: &Plan,
-) -> Result<GpuImages, String> {
+) -> Result<Vec<GpuImage>, String> {
     let e = |e: gpu::GpuError| e.to_string();
     let start = Instant::now();
     let geometry = SceneGeometry::upload(gpu, scene).map_err(e)?;
     let gb = passes.gbuffer.render(gpu, &geometry, &scene.camera).map_err(e)?;
     let points = gb.read_points(gpu).map_err(e)?;
-    let tris = gpu::scene_triangles(scene);
-    let shadow_geometry = ShadowGeometry::upload(gpu, &tris, ShadowGeometry::CHUNK_TRIANGLES).map_err(e)?;
-    let mapper = &passes.shadows;
-    let settings = ShadowSettings { focus: view_focus(&points), ..plan.shadow };
+    let receivers = Receivers::new(&gb, &points);
     let lights: Vec<ShadeLight> = d.lights.iter().map(|l| ShadeLight::from(&l.light)).collect();
+    let shapes: Vec<LightShape> = d.lights.iter().map(|l| LightShape::from(&l.light)).collect();
     let (w, h) = gb.size();
-    let vis = Visibility::new(gpu, w, h, lights.len() as u32).map_err(e)?;
-    let mut shadow_ms = 0.0;
-    for (k, l) in d.lights.iter().enumerate() {
-        // model only what the scene requires: a light that no visible surface faces lights
-        // nothing (the shading pass skips it per pixel), so it needs no shadow map
-        if !points.iter().any(|(p, n)| p.is_finite() && n.dot(l.light.direction) > 0.0) {
-            continue;
-        }
-        let light = ShadowLight::Distant { direction: l.light.direction };
-        let m = mapper.render(gpu, &shadow_geometry, &light, Technique::Orthographic, &settings).map_err(e)?;
-        shadow_ms += m.time.as_secs_f64() * 1e3;
-        mapper.visibility(gpu, &m, &gb, &vis.layer(k as u32)).map_err(e)?;
-    }
     let pass = &passes.shading;
     let background = Background::upload(gpu, map).map_err(e)?;
     let params = ShadeParams { lights: &lights, ambient: Some(&d.ambient_sh), background: Some(&background) };
-    let image = pass.render(gpu, &geometry, &gb, &params, &vis).map_err(e)?;
-    let seconds = start.elapsed().as_secs_f64();
+    let common = start.elapsed().as_secs_f64();
+    let mut out = Vec::new();
+    let mut all = techniques(gpu, scene, plan)?;
+    all.push((
+        "gpu_traced_visibility".into(),
+        Box::new(traced_visibility(gpu, scene, &receivers, &shapes, plan.truth_directions)?),
+    ));
+    for (name, technique) in all {
+        let t = Instant::now();
+        let vis = Visibility::new(gpu, w, h, lights.len() as u32).map_err(e)?;
+        let reports = render_visibility(gpu, technique.as_ref(), &receivers, &shapes, &vis).map_err(e)?;
+        let image = pass.render(gpu, &geometry, &gb, &params, &vis).map_err(e)?;
+        let (time, shadowed, skipped, _) = gpu::totals(&reports);
+        let shadow_ms = time.as_secs_f64() * 1e3;
+        out.push(GpuImage {
+            what: format!(
+                "GPU: {} lights with {} ({shadowed} shadowed, {skipped} skipped: no visible receiver faces them; {shadow_ms:.1} ms), + SH9 ambient",
+                lights.len(),
+                technique.name(),
+            ),
+            name,
+            image,
+            seconds: common + t.elapsed().as_secs_f64(),
+        });
+    }
     let lit = Visibility::new(gpu, w, h, lights.len() as u32).map_err(e)?;
     let unshadowed = pass.render(gpu, &geometry, &gb, &params, &lit).map_err(e)?;
-    Ok((image, unshadowed, seconds, shadow_ms))
+    out.push(GpuImage {
+        name: "gpu_unshadowed".into(),
+        what: "GPU: the same lights without shadows".into(),
+        image: unshadowed,
+        seconds: 0.0,
+    });
+    Ok(out)
 }
 
 pub(super) type MaskImages = (Vec<f32>, Vec<f32>, Vec<Option<bool>>, (u32, u32));

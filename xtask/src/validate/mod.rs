@@ -63,6 +63,10 @@ struct Plan {
     shadow: ShadowSettings,
     room_size: (u32, u32),
     repeats: usize,
+    /// Maps per light of the N-sample technique (at half the resolution).
+    multi_samples: u32,
+    /// Ray-traced visibility of the truth row: n × n directions per pixel and light.
+    truth_directions: u32,
 }
 
 impl Plan {
@@ -77,6 +81,8 @@ impl Plan {
                 shadow: ShadowSettings { resolution: 1024, ..shadow },
                 room_size: (320, 240),
                 repeats: 3,
+                multi_samples: 4,
+                truth_directions: 4,
             }
         } else {
             Self {
@@ -87,6 +93,8 @@ impl Plan {
                 shadow,
                 room_size: (640, 480),
                 repeats: 7,
+                multi_samples: 16,
+                truth_directions: 4,
             }
         }
     }
@@ -191,13 +199,13 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
     let traced = ref_tracer::render(&scene, &bvh, None, &Integrator::Lights(set), &settings, &|_, _| {});
     let traced_s = t.elapsed().as_secs_f64();
 
-    stages.next(&format!("GPU: G-buffer, orthographic shadow maps, shading ({})", gpu.info.name));
+    stages.next(&format!("GPU: G-buffer, shadow techniques (maps, PCSS, N maps, wedges), shading ({})", gpu.info.name));
     let passes = Passes {
         gbuffer: GBufferPass::new(&gpu),
         shadows: ShadowMapper::new(&gpu),
         shading: ShadingPass::new(&gpu).map_err(|e| e.to_string())?,
     };
-    let (gpu_image, gpu_unshadowed, gpu_s, shadow_ms) = gpu_render(&gpu, &passes, &scene, &map, &decomposition, &plan)?;
+    let gpu_images = gpu_render(&gpu, &passes, &scene, &map, &decomposition, &plan)?;
 
     stages.next("room: point-light shadow maps against ray-traced visibility, and their speed");
     let (mask_rows, mask_images, size_rows, clock) = room_masks(&gpu, &passes, &plan)?;
@@ -214,33 +222,21 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
         flip: None,
         rmse_vs_lights: None,
     }];
-    for (name, what, image, seconds) in [
-        (
-            "lights_ray_traced",
-            format!(
-                "ref-tracer lights: {} lights + SH9 ambient, 8 interleaved sets, {} spp",
-                lights.len(),
-                plan.lights_spp
-            ),
-            traced.color.clone(),
-            traced_s,
+    let traced_row = (
+        "lights_ray_traced".to_string(),
+        format!(
+            "ref-tracer lights: {} lights + SH9 ambient, 8 interleaved sets, {} spp",
+            lights.len(),
+            plan.lights_spp
         ),
-        (
-            "gpu_shadow_maps",
-            format!(
-                "GPU: {} lights with orthographic shadow maps {}², PCF {}, + SH9 ambient (shadow maps {shadow_ms:.1} ms)",
-                lights.len(),
-                plan.shadow.resolution,
-                plan.shadow.pcf_radius
-            ),
-            gpu_image,
-            gpu_s,
-        ),
-        ("gpu_unshadowed", "GPU: the same lights without shadows".to_string(), gpu_unshadowed, 0.0),
-    ] {
+        traced.color.clone(),
+        traced_s,
+    );
+    let gpu_rows = gpu_images.into_iter().map(|g| (g.name, g.what, g.image, g.seconds));
+    for (name, what, image, seconds) in std::iter::once(traced_row).chain(gpu_rows) {
         let (r, f) = metric(&image);
         rows.push(Row {
-            name: name.into(),
+            name: name.clone(),
             what,
             rmse_vs_lights: (name != "lights_ray_traced").then(|| rmse(&traced.color, &image)),
             image,
