@@ -18,6 +18,7 @@ mod info;
 mod lavapipe;
 mod render;
 mod scene;
+mod soft_shadows;
 mod test;
 mod validate;
 
@@ -134,6 +135,23 @@ enum Command {
         #[arg(long, default_value_t = 1)]
         seed: u64,
     },
+    /// Soft shadows: every technique's visibility error against ray-traced visibility and
+    /// its GPU time per light, per scene and light size (0.25 to 45 degrees), and each
+    /// technique's speed at the wedges' error; OUT/soft_shadows.{csv,md}.
+    SoftShadows {
+        /// Comma-separated built-in scenes; three_boxes, column and spheres_box when absent.
+        #[arg(long, value_delimiter = ',')]
+        scenes: Vec<String>,
+        /// Image size WIDTHxHEIGHT.
+        #[arg(long, value_parser = parse_size, default_value = "640x480")]
+        size: (u32, u32),
+        /// The GPU adapter: a case-insensitive part of its name, or `cpu`.
+        #[arg(long)]
+        adapter: Option<String>,
+        /// Output folder.
+        #[arg(long, default_value = "target/soft-shadows")]
+        out: PathBuf,
+    },
     /// Print an environment map's size, format, luminance, power and SH9 coefficients.
     Info {
         /// The map (.exr or .hdr).
@@ -156,6 +174,9 @@ fn main() -> ExitCode {
         Command::Validate(args) => validate::run(&args),
         Command::Test { adapter, args } => test::run(adapter.as_deref(), &args),
         Command::Info { path, json } => info::run(&path, json),
+        Command::SoftShadows { scenes, size, adapter, out } => {
+            soft_shadows::run(&scenes, size, adapter.as_deref(), &out)
+        }
         Command::Scene { name, obj } => scene::run(&name, &obj),
         Command::Render(args) => render::run(&args),
         Command::Compare { reference, test } => render::compare(&reference, &test),

@@ -27,7 +27,7 @@ pub use context::{ADAPTER_ENV, Gpu, GpuError, adapters, describe_adapter, pick_a
 pub use gbuffer::{GBUFFER_FORMAT, GBuffer, GBufferPass, view_projection, view_projection_infinite};
 pub use geometry::{Chunk, SceneGeometry, ShadowGeometry, scene_triangles};
 pub use readback::{read_texture_f32, read_texture_rgba};
-pub use shade::{Background, HDR_FORMAT, ShadeLight, ShadeParams, ShadingPass, Visibility};
+pub use shade::{Background, HDR_FORMAT, ShadeLight, ShadeParams, ShadingPass, Visibility, downsample_box};
 pub use target::{layer_view, render_target};
 pub use technique::{
     LightShape, PrecomputedVisibility, Receivers, ShadowPassReport, ShadowTechnique, render_visibility, totals,

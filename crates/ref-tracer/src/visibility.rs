@@ -116,3 +116,39 @@ pub fn area_light_visibility(bvh: &SceneBvh, points: &[(Vec3, Vec3)], light: Are
         })
         .collect()
 }
+
+/// [`area_light_visibility`] with `coarse` × `coarse` directions everywhere, refined to `fine` ×
+/// `fine` where the coarse estimate is partial or differs from a 4-neighbour's (the points are
+/// an image `width` wide): penumbrae get the fine estimate at a fraction of its cost. A
+/// penumbra narrower than a pixel that all coarse directions miss stays unrefined.
+#[must_use]
+pub fn area_light_visibility_refined(
+    bvh: &SceneBvh,
+    points: &[(Vec3, Vec3)],
+    light: AreaLight,
+    width: usize,
+    coarse: u32,
+    fine: u32,
+) -> Vec<Option<f32>> {
+    let mut out = area_light_visibility(bvh, points, light, coarse);
+    let w = width.max(1);
+    let h = out.len() / w;
+    let refine: Vec<usize> = (0..out.len())
+        .filter(|&k| {
+            let Some(v) = out[k] else { return false };
+            if v > 0.0 && v < 1.0 {
+                return true;
+            }
+            let (x, y) = (k % w, k / w);
+            [(x.wrapping_sub(1), y), (x + 1, y), (x, y.wrapping_sub(1)), (x, y + 1)]
+                .into_iter()
+                .filter(|&(nx, ny)| nx < w && ny < h)
+                .any(|(nx, ny)| out[ny * w + nx].is_some_and(|u| u != v))
+        })
+        .collect();
+    let subset: Vec<(Vec3, Vec3)> = refine.iter().map(|&k| points[k]).collect();
+    for (k, v) in refine.into_iter().zip(area_light_visibility(bvh, &subset, light, fine)) {
+        out[k] = v;
+    }
+    out
+}

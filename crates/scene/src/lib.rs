@@ -19,7 +19,7 @@ mod obj;
 
 pub use builtin::BUILTIN_SCENES;
 pub use camera::{Camera, CameraRays};
-pub use light::DistantLight;
+pub use light::{DistantLight, cone_cosine_integral};
 pub use material::{Ggx, Material};
 pub use mesh::Mesh;
 

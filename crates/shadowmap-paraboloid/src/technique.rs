@@ -78,7 +78,7 @@ impl ShadowTechnique for MapTechnique {
     fn name(&self) -> String {
         let res = self.settings.resolution;
         match (self.technique, self.samples, self.settings.pcss) {
-            (Technique::Orthographic, 1, Some(_)) => format!("pcss_{res}"),
+            (Technique::Orthographic, 1, Some(p)) => format!("pcss_{res}_f{}", p.filter_samples),
             (Technique::Orthographic, 1, None) => format!("shadow_maps_{res}_pcf{}", self.settings.pcf_radius),
             (Technique::Orthographic, n, _) => format!("shadow_maps_{res}_x{n}"),
             (Technique::Cube, ..) => format!("cube_{res}"),

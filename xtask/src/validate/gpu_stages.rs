@@ -8,11 +8,11 @@ use envmap_sphere::EnvMap;
 use glam::Vec3;
 use gpu::{
     Background, GBufferPass, Gpu, LightShape, PrecomputedVisibility, Receivers, SceneGeometry, ShadeLight, ShadeParams,
-    ShadingPass, ShadowGeometry, ShadowTechnique, Visibility, render_visibility,
+    ShadingPass, ShadowGeometry, ShadowTechnique, Visibility, downsample_box, render_visibility,
 };
 use penumbra_wedge::{WedgeSettings, Wedges};
 use ref_tracer::SceneBvh;
-use ref_tracer::visibility::{AreaLight, VisibilityLight, area_light_visibility, light_visibility};
+use ref_tracer::visibility::{AreaLight, VisibilityLight, area_light_visibility_refined, light_visibility};
 use shadowmap_paraboloid::{
     MapTechnique, Pcss, ShadowLight, ShadowMapper, ShadowSettings, Technique, disagreement, equal_texel_variants,
     shadow_triangles,
@@ -35,8 +35,8 @@ pub(super) struct Passes {
     pub(super) shading: ShadingPass,
 }
 
-/// Ray-traced visibility of each light from the G-buffer's points (`n` × `n` stratified
-/// directions per pixel; pixels the light cannot reach stay lit).
+/// Ray-traced visibility of each light from the G-buffer's points (2 × 2 stratified directions,
+/// `n` × `n` in and next to penumbrae; pixels the light cannot reach stay lit).
 fn traced_visibility(
     gpu: &Gpu,
     scene: &scene::Scene,
@@ -51,7 +51,9 @@ fn traced_visibility(
             let LightShape::Distant { direction, half_angle } = *s else {
                 unreachable!("extracted lights are distant")
             };
-            let v = area_light_visibility(&bvh, receivers.points, AreaLight::Cone { direction, half_angle }, n);
+            let cone = AreaLight::Cone { direction, half_angle };
+            let width = receivers.gbuffer.size().0 as usize;
+            let v = area_light_visibility_refined(&bvh, receivers.points, cone, width, 2, n);
             (*s, v.into_iter().map(|v| v.unwrap_or(1.0)).collect())
         })
         .collect();
@@ -99,6 +101,13 @@ pub(super) fn gpu_render(
 ) -> Result<Vec<GpuImage>, String> {
     let e = |e: gpu::GpuError| e.to_string();
     let start = Instant::now();
+    // supersampled as the ray tracer's pixels are (box filter): edges alias otherwise, and
+    // their error would hide the shadows'
+    let ss = plan.gpu_supersample.max(1);
+    let mut scene = scene.clone();
+    let size = (scene.camera.width, scene.camera.height);
+    (scene.camera.width, scene.camera.height) = (size.0 * ss, size.1 * ss);
+    let scene = &scene;
     let geometry = SceneGeometry::upload(gpu, scene).map_err(e)?;
     let gb = passes.gbuffer.render(gpu, &geometry, &scene.camera).map_err(e)?;
     let points = gb.read_points(gpu).map_err(e)?;
@@ -120,7 +129,7 @@ pub(super) fn gpu_render(
         let t = Instant::now();
         let vis = Visibility::new(gpu, w, h, lights.len() as u32).map_err(e)?;
         let reports = render_visibility(gpu, technique.as_ref(), &receivers, &shapes, &vis).map_err(e)?;
-        let image = pass.render(gpu, &geometry, &gb, &params, &vis).map_err(e)?;
+        let image = downsample_box(&pass.render(gpu, &geometry, &gb, &params, &vis).map_err(e)?, size, ss);
         let (time, shadowed, skipped, _) = gpu::totals(&reports);
         let shadow_ms = time.as_secs_f64() * 1e3;
         out.push(GpuImage {
@@ -135,7 +144,7 @@ pub(super) fn gpu_render(
         });
     }
     let lit = Visibility::new(gpu, w, h, lights.len() as u32).map_err(e)?;
-    let unshadowed = pass.render(gpu, &geometry, &gb, &params, &lit).map_err(e)?;
+    let unshadowed = downsample_box(&pass.render(gpu, &geometry, &gb, &params, &lit).map_err(e)?, size, ss);
     out.push(GpuImage {
         name: "gpu_unshadowed".into(),
         what: "GPU: the same lights without shadows".into(),

@@ -67,6 +67,8 @@ struct Plan {
     multi_samples: u32,
     /// Ray-traced visibility of the truth row: n × n directions per pixel and light.
     truth_directions: u32,
+    /// GPU images at s × s samples per pixel, box-filtered (the ray tracer's pixel filter).
+    gpu_supersample: u32,
 }
 
 impl Plan {
@@ -82,7 +84,8 @@ impl Plan {
                 room_size: (320, 240),
                 repeats: 3,
                 multi_samples: 4,
-                truth_directions: 4,
+                truth_directions: 8,
+                gpu_supersample: 2,
             }
         } else {
             Self {
@@ -94,7 +97,8 @@ impl Plan {
                 room_size: (640, 480),
                 repeats: 7,
                 multi_samples: 16,
-                truth_directions: 4,
+                truth_directions: 8,
+                gpu_supersample: 2,
             }
         }
     }
@@ -288,6 +292,10 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
         if let (Some(rm), Some(fl)) = (r.rmse, r.flip) {
             outln!("  {:<18} RMSE {rm:.4}  FLIP {fl:.4}  {:.2} s", r.name, r.seconds);
         }
+    }
+    let rmse_of = |n: &str| rows.iter().find(|r| r.name == n).and_then(|r| r.rmse);
+    if let (Some(g), Some(t)) = (rmse_of("gpu_wedges"), rmse_of("lights_ray_traced")) {
+        outln!("  gpu_wedges / lights_ray_traced RMSE: {:.2}x (goal 1.2x)", g / t);
     }
     for m in &mask_rows {
         outln!("  room {:<26} {:>7.3} % of pixels disagree  {:>7.2} ms", m.name, m.disagreement * 100.0, m.gpu_ms);
