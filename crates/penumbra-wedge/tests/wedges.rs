@@ -207,3 +207,62 @@ fn light_below_every_receiver_and_culling_reports() {
     assert!(f.report.primitives > 0);
     assert_eq!(f.report.culled.len(), 3);
 }
+
+#[test]
+fn grazing_light_stays_finite_and_near_the_truth() {
+    // 3 degrees above the horizon, 1 degree wide: long shadows across the ground
+    let light =
+        LightShape::Distant { direction: Vec3::new(0.8, 0.052, 0.6).normalize(), half_angle: 1f32.to_radians() };
+    let f = render(scene("three_boxes", 160, 120), light);
+    assert!(f.wedges.iter().all(|v| v.is_finite() && (0.0..=1.0).contains(v)));
+    let (mean, _, _, _) = compare(&f.wedges, &f.truth(&light), 0.05);
+    assert!(mean < 0.02, "mean {mean}");
+}
+
+#[test]
+fn shadows_that_miss_the_view_cull_their_wedges() {
+    // a box behind the camera casts away from it: its shadow cannot reach anything in view, so
+    // it gets no volume and no wedges (and the column's shadow is unchanged)
+    let mut s = scene("column", 120, 90);
+    s.objects.push(scene::Object {
+        name: "behind".into(),
+        mesh: scene::Mesh::cuboid(Vec3::new(-0.5, 0.0, 29.5), Vec3::new(0.5, 1.0, 30.5)),
+        material: scene::Material::lambert(0.5),
+    });
+    s.camera.eye = Vec3::new(0.0, 2.0, 8.0);
+    s.camera.target = Vec3::new(0.0, 1.0, 0.0);
+    let light = LightShape::Distant { direction: Vec3::new(0.0, 0.6, -1.0).normalize(), half_angle: 0.02 };
+    let f = render(s, light);
+    let (mean, _, _, _) = compare(&f.wedges, &f.truth(&light), 0.05);
+    assert!(mean < 0.01, "mean {mean}");
+    assert_eq!(f.report.culled[0], ("casters whose shadow cannot reach a visible receiver", 1));
+}
+
+#[test]
+fn overlapping_casters_are_counted_twice_where_both_cover_the_light() {
+    // two stacked boxes (closed casters) one above the other: from the ground below, both
+    // silhouettes cover the light's disk, so their edge terms add; the wedge sum clamps, but
+    // where both partly cover it, it darkens too much. The artefact, measured on lavapipe: mean
+    // error 0.14 in penumbrae (0.007 over all pixels), against 0.002-0.014 for single casters;
+    // the CPU mirror has it too (the method, not the GPU code).
+    let mut s = scene("three_boxes", 160, 120);
+    s.objects.truncate(1);
+    for (k, (lo, hi)) in
+        [(Vec3::new(-0.8, 1.0, -0.6), Vec3::new(0.4, 1.2, 0.6)), (Vec3::new(-0.4, 1.8, -0.4), Vec3::new(0.8, 2.0, 0.8))]
+            .into_iter()
+            .enumerate()
+    {
+        s.objects.push(scene::Object {
+            name: format!("slab{k}"),
+            mesh: scene::Mesh::cuboid(lo, hi),
+            material: scene::Material::lambert(0.7),
+        });
+    }
+    let light = sun(8.0);
+    let f = render(s, light);
+    let (mean, soft_mean, _, soft) = compare(&f.wedges, &f.truth(&light), 0.05);
+    assert!(soft > 100, "{soft}");
+    assert!(mean < 0.015 && soft_mean < 0.2, "mean {mean}, in penumbrae {soft_mean}");
+    let (mirror, _, _, _) = compare(&f.wedges, &f.mirror(&light), 0.05);
+    assert!(mirror < 0.002, "GPU against its CPU mirror: {mirror}");
+}

@@ -1,5 +1,5 @@
 //! `cargo xtask validate`: the main job. On the embedded default map and `spheres_box` (or the
-//! given ones): decompose the map with EmissiveSplit, render the lights on the GPU with
+//! given ones): decompose the map with EmissiveSplit (or `--method`), render the lights on the GPU with
 //! orthographic shadow maps (and without shadows), render the `ref-tracer` references, measure
 //! the `room` point light's paraboloid and cube shadow maps against ray-traced visibility and
 //! time them, write `target/validate/report.html` (self-contained), and fail when an error
@@ -13,7 +13,6 @@ use crate::render::load_map;
 use glam::Vec3;
 use gpu::{GBufferPass, ShadingPass};
 use gpu_stages::{MaskImages, Passes, SizeRow, gpu_render, room_masks};
-use light_extract::{EmissiveSplit, LightExtractor};
 use ref_tracer::metrics::{FlipTonemap, flip, rmse};
 use ref_tracer::{EnvLight, Integrator, LightSet, RenderSettings, SceneBvh, Strategy};
 use report::Report;
@@ -31,6 +30,10 @@ pub struct ValidateArgs {
     /// Built-in scene lit by the map.
     #[arg(long, default_value = "spheres_box")]
     pub scene: String,
+    /// Light extraction method (as `cargo xtask extract --method`); thresholds are recorded for
+    /// the default only, other methods' keys carry the method.
+    #[arg(long, default_value = "emissive-split")]
+    pub method: String,
     /// Smaller images and fewer samples: about 17 s on 2 cores once built.
     #[arg(long)]
     pub quick: bool,
@@ -105,15 +108,19 @@ impl Plan {
 
     fn describe(&self) -> String {
         format!(
-            "{}x{}, reference {} spp, ray-traced lights {} spp, K = {}, orthographic maps {}² with PCF {}x{}, room masks {}x{}, timings median of {}",
+            "{}x{}, reference {} spp, ray-traced lights {} spp, K = {}, GPU images {}x{} supersampled, orthographic maps {}² with PCF {}x{} (PCSS on the same maps; {} maps of {}² per light), room masks {}x{}, timings median of {}",
             self.size.0,
             self.size.1,
             self.reference_spp,
             self.lights_spp,
             self.lights,
+            self.gpu_supersample,
+            self.gpu_supersample,
             self.shadow.resolution,
             2 * self.shadow.pcf_radius + 1,
             2 * self.shadow.pcf_radius + 1,
+            self.multi_samples,
+            self.shadow.resolution / 2,
             self.room_size.0,
             self.room_size.1,
             self.repeats
@@ -172,10 +179,10 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
     (scene.camera.width, scene.camera.height) = plan.size;
     let (w, h) = plan.size;
 
-    stages.next("extract lights (EmissiveSplit)");
-    let decomposition = EmissiveSplit { lights: plan.lights, ..EmissiveSplit::default() }
-        .extract(&map)
-        .map_err(|e| format!("{map_name}: {e}"))?;
+    stages.next(&format!("extract lights ({})", args.method));
+    let extractor = light_extract::extractor(&args.method, plan.lights)
+        .ok_or_else(|| format!("unknown method {} (see cargo xtask extract --help)", args.method))?;
+    let decomposition = extractor.extract(&map).map_err(|e| format!("{map_name}: {e}"))?;
     let lights = decomposition.distant_lights();
     let sets = decomposition.interleaved_distant_lights();
 
@@ -252,7 +259,8 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
 
     stages.next("report and thresholds");
     std::fs::create_dir_all(&args.out).map_err(|e| format!("{}: {e}", args.out.display()))?;
-    let key = format!("{}@{}{}", args.scene, map_name, if args.quick { "/quick" } else { "" });
+    let method = if args.method == "emissive-split" { String::new() } else { format!("[{}]", args.method) };
+    let key = format!("{}@{}{method}{}", args.scene, map_name, if args.quick { "/quick" } else { "" });
     let mut measured: BTreeMap<String, f64> = BTreeMap::new();
     for r in &rows {
         if let (Some(rm), Some(fl)) = (r.rmse, r.flip) {
@@ -284,6 +292,7 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
         failures: &failures,
         checked,
         lights: lights.len(),
+        method: &args.method,
         extract_ms: decomposition.time_ms,
     };
     let path = args.out.join("report.html");

@@ -26,6 +26,7 @@ pub(super) struct Report<'a> {
     pub(super) checked: usize,
     pub(super) lights: usize,
     pub(super) extract_ms: f64,
+    pub(super) method: &'a str,
 }
 
 /// Relative luminance error as an 8-bit heat map (black 0, red 25 %, yellow 50 %, white ≥ 75 %).
@@ -100,7 +101,8 @@ impl Report<'_> {
         );
         let _ = write!(
             s,
-            "<p>EmissiveSplit found {} lights in {:.1} ms. {}</p>",
+            "<p>{} found {} lights in {:.1} ms. {}</p>",
+            html_escape(self.method),
             self.lights,
             self.extract_ms,
             html_escape(&self.tm.describe())
