@@ -48,12 +48,12 @@ fn traced_visibility(
     let layers = shapes
         .iter()
         .map(|s| {
-            let LightShape::Distant { direction, half_angle } = *s else {
-                unreachable!("extracted lights are distant")
+            let area = match *s {
+                LightShape::Distant { direction, half_angle } => AreaLight::Cone { direction, half_angle },
+                LightShape::Sphere { center, radius } => AreaLight::Sphere { center, radius },
             };
-            let cone = AreaLight::Cone { direction, half_angle };
             let width = receivers.gbuffer.size().0 as usize;
-            let v = area_light_visibility_refined(&bvh, receivers.points, cone, width, 2, n);
+            let v = area_light_visibility_refined(&bvh, receivers.points, area, width, 2, n);
             (*s, v.into_iter().map(|v| v.unwrap_or(1.0)).collect())
         })
         .collect();
