@@ -102,7 +102,8 @@ pub fn reach_along(
 
 /// The 18 points whose convex hull contains edge `[v0, v1]`'s wedge out to `extent`, or `None`
 /// when an endpoint is within the light (a local light's edge that close is skipped). With
-/// `receivers`, a distant light's wedge stops where it can no longer meet them.
+/// `receivers`, a distant light's wedge stops where it can no longer meet them (`None` when it
+/// cannot meet them at all).
 #[must_use]
 pub fn wedge_hull_points(
     v0: Vec3,

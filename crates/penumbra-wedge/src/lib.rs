@@ -227,6 +227,9 @@ impl Wedges {
                                 points.extend(p);
                                 edges.push([a, b]);
                             }
+                            // a distant light's wedge that cannot reach a receiver, or a local
+                            // light's edge with an endpoint inside it
+                            None if matches!(light, LightShape::Distant { .. }) => away += 1,
                             None => at_light += 1,
                         }
                     }
