@@ -39,20 +39,21 @@ pub struct Entry {
 /// # Errors
 /// GPU failures.
 pub fn entries(gpu: &Gpu, scene: &scene::Scene) -> Result<Vec<Entry>, GpuError> {
-    let map = |settings: ShadowSettings, n: u32| MapTechnique::new(gpu, scene, Technique::Orthographic, settings, n);
     let hard = ShadowSettings { resolution: 2048, pcf_radius: 1, ..ShadowSettings::default() };
+    let maps = MapTechnique::new(gpu, scene, Technique::Orthographic, hard, 1)?;
+    let map = |settings: ShadowSettings, n: u32| Box::new(maps.variant(Technique::Orthographic, settings, n));
     let mut out = vec![
         Entry { family: "wedges", technique: Box::new(Wedges::new(gpu, scene, WedgeSettings::default())) },
-        Entry { family: "shadow_maps", technique: Box::new(map(hard, 1)?) },
+        Entry { family: "shadow_maps", technique: map(hard, 1) },
     ];
     for filter_samples in [8, 32, 64] {
         let pcss = Pcss { filter_samples, blocker_samples: filter_samples.min(16), ..Pcss::default() };
         let settings = ShadowSettings { pcf_radius: 0, pcss: Some(pcss), ..hard };
-        out.push(Entry { family: "pcss", technique: Box::new(map(settings, 1)?) });
+        out.push(Entry { family: "pcss", technique: map(settings, 1) });
     }
     for n in [4, 16, 64] {
         let settings = ShadowSettings { resolution: 1024, pcf_radius: 0, ..hard };
-        out.push(Entry { family: "shadow_maps_xN", technique: Box::new(map(settings, n)?) });
+        out.push(Entry { family: "shadow_maps_xN", technique: map(settings, n) });
     }
     Ok(out)
 }

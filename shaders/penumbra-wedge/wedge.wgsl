@@ -1,22 +1,13 @@
+// requires: penumbra-wedge/light.wgsl
 // Penumbra wedges: per pixel of a footprint (the conservative hull of a few consecutive
 // silhouette edges' wedges), each edge's signed coverage of the light's disk seen from the
 // G-buffer point, a_e / pi, summed and added to the accumulator's g
 // (`penumbra_wedge::coverage` is the same computation on the CPU; its doc derives it).
 
-struct Light {
-    // xyz unit direction towards a distant light, or a sphere light's centre
-    position_or_direction: vec4<f32>,
-    // x 0 distant, 1 sphere; y half-angle (distant) or radius (sphere)
-    config: vec4<f32>,
-}
-
 struct Edge {
     v0: vec4<f32>,
     v1: vec4<f32>,
 }
-
-const PI: f32 = 3.14159265358979;
-const MAX_HALF_ANGLE: f32 = 1.5;
 
 @group(0) @binding(0) var<uniform> light: Light;
 @group(0) @binding(1) var<storage, read> edges: array<Edge>;
@@ -65,38 +56,6 @@ fn segment_term(q0: vec2<f32>, q1: vec2<f32>) -> f32 {
     return (g_term(h, dot(q1, s_hat)) - g_term(h, dot(q0, s_hat))) / PI;
 }
 
-// The light seen from a receiver: its frame (z towards the centre), tan of its half-angle, and
-// the farthest z that still occludes it.
-struct LightFrame {
-    x: vec3<f32>,
-    y: vec3<f32>,
-    z: vec3<f32>,
-    tan_a: f32,
-    z_max: f32,
-}
-
-fn light_frame(p: vec3<f32>) -> LightFrame {
-    var f: LightFrame;
-    var alpha: f32;
-    f.z_max = 3.0e38;
-    if light.config.x < 0.5 {
-        f.z = light.position_or_direction.xyz;
-        alpha = light.config.y;
-    } else {
-        let to_c = light.position_or_direction.xyz - p;
-        let dist = length(to_c);
-        f.z = to_c / max(dist, 1e-30);
-        alpha = select(asin(min(light.config.y / dist, 1.0)), PI * 0.5, dist <= light.config.y);
-        f.z_max = dist * cos(alpha) * cos(alpha);
-    }
-    alpha = clamp(alpha, 1e-7, MAX_HALF_ANGLE);
-    let helper = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(f.z.x) > 0.9);
-    f.x = normalize(cross(helper, f.z));
-    f.y = cross(f.z, f.x);
-    f.tan_a = tan(alpha);
-    return f;
-}
-
 fn edge_term(p: vec3<f32>, f: LightFrame, v0: vec3<f32>, v1: vec3<f32>) -> f32 {
     let d0 = v0 - p;
     let d1 = v1 - p;
@@ -136,7 +95,7 @@ fn fs(in: VsOut) -> @location(0) vec4<f32> {
     if g.w < 0.0 {
         discard;
     }
-    let f = light_frame(g.xyz);
+    let f = light_frame(light, g.xyz);
     var sum = 0.0;
     for (var k = in.first; k < in.first + in.count; k++) {
         let e = edges[k];

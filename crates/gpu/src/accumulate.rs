@@ -1,6 +1,6 @@
 //! Additive accumulation of per-pixel terms and its resolve into a visibility layer: shadow
 //! techniques that sum several passes (N shadow maps averaged; a hard count and wedge terms)
-//! blend into an [`Accumulator`] and [`ResolvePass`] turns it into visibility.
+//! blend into an [`Accumulator`] and a [`ResolvePass`] turns it into visibility.
 //!
 //! The accumulator is `Rg32Float` where the adapter can blend 32-bit floats
 //! (`FLOAT32_BLENDABLE`), else `Rg16Float` (whole counts stay exact; sums of fractions carry
@@ -78,69 +78,63 @@ impl Accumulator {
     }
 }
 
-/// How [`ResolvePass`] turns the accumulated channels into visibility.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Resolve {
-    /// `clamp(r × scale)`: e.g. the mean of N lit tests with scale 1/N.
-    Scale(f32),
-    /// `clamp(1 − w + g)` with `w = 1` where the hard count `r` is not 0 (penumbra wedges) for
-    /// this light, divided by the fraction of its disk above the surface's own plane (the
-    /// shading's cone integral already leaves that part out; casters the point lies on hide
-    /// it from the wedge sum).
-    Wedges(crate::LightShape),
-}
-
-/// The resolve pass: pipeline built once.
+/// The resolve pass: a full-screen pass reading the accumulator and writing a visibility
+/// layer. Its shader binds the pass's uniform at 0, the G-buffer positions at 1 and the
+/// accumulator at 2 (and any extra bindings its caller passes); the default one writes the mean
+/// of N lit tests, `clamp(r × scale)`. Techniques with their own resolve (penumbra wedges) bring
+/// their shader.
 pub struct ResolvePass {
     pipeline: wgpu::RenderPipeline,
 }
 
 impl ResolvePass {
-    /// Builds the pipeline.
+    /// The mean of N lit tests: `clamp(r × scale)` (`shaders/gpu/resolve.wgsl`).
     #[must_use]
     pub fn new(gpu: &Gpu) -> Self {
-        let module =
-            crate::shader::module(&gpu.device, "resolve", include_str!("../../../shaders/gpu/resolve.wgsl"), &[]);
-        Self { pipeline: crate::fullscreen::pipeline(gpu, "resolve", &module, crate::shade::Visibility::FORMAT) }
+        Self::with_shader(gpu, "resolve", include_str!("../../../shaders/gpu/resolve.wgsl"), &[])
     }
 
-    /// Records the resolve of `acc` into `target` (a visibility layer) into `encoder`.
+    /// A resolve pass with its own fragment shader (`library`: WGSL files its `// requires:`
+    /// lines name outside this crate).
+    #[must_use]
+    pub fn with_shader(gpu: &Gpu, label: &str, source: &str, library: &[(&str, &str)]) -> Self {
+        let module = crate::shader::module(&gpu.device, label, source, library);
+        Self { pipeline: crate::fullscreen::pipeline(gpu, label, &module, crate::shade::Visibility::FORMAT) }
+    }
+
+    /// Records the resolve of `acc` into `target` (a visibility layer): `params` is the
+    /// uniform at binding 0, `extra` any further bindings the shader reads.
+    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         gpu: &Gpu,
         encoder: &mut wgpu::CommandEncoder,
         gbuffer: &GBuffer,
         acc: &Accumulator,
-        how: Resolve,
+        params: &[u8],
+        extra: &[(u32, wgpu::BindingResource<'_>)],
         target: &wgpu::TextureView,
     ) {
-        let config: [[f32; 4]; 3] = match how {
-            Resolve::Scale(s) => [[0.0, s, 0.0, 0.0], [0.0; 4], [0.0; 4]],
-            Resolve::Wedges(crate::LightShape::Distant { direction, half_angle }) => [
-                [1.0, 1.0, 0.0, 0.0],
-                direction.normalize_or(glam::Vec3::Y).extend(0.0).to_array(),
-                [0.0, half_angle, 0.0, 0.0],
-            ],
-            Resolve::Wedges(crate::LightShape::Sphere { center, radius }) => {
-                [[1.0, 1.0, 0.0, 0.0], center.extend(1.0).to_array(), [1.0, radius, 0.0, 0.0]]
-            }
-        };
         let buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("resolve"),
-            contents: bytemuck::cast_slice(&config),
+            contents: params,
             usage: wgpu::BufferUsages::UNIFORM,
         });
         let position = gbuffer.position.create_view(&Default::default());
-        let normal = gbuffer.geometric_normal.create_view(&Default::default());
+        let mut entries = vec![
+            wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&position) },
+            wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&acc.view) },
+        ];
+        entries.extend(
+            extra
+                .iter()
+                .map(|(binding, resource)| wgpu::BindGroupEntry { binding: *binding, resource: resource.clone() }),
+        );
         let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("resolve"),
             layout: &self.pipeline.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&position) },
-                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&normal) },
-                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&acc.view) },
-            ],
+            entries: &entries,
         });
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("resolve"),

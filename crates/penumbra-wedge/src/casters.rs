@@ -112,10 +112,11 @@ impl Casters {
 
     /// The silhouette of the casters `keep` accepts, from `light`'s centre.
     #[must_use]
-    pub fn silhouette(&self, light: &LightShape, mut keep: impl FnMut(&Caster) -> bool) -> Silhouette {
+    pub fn silhouette(&self, light: &LightShape, keep: impl FnMut(&Caster) -> bool) -> Silhouette {
         let mut out = Silhouette::default();
-        for c in self.casters.iter().filter(|c| keep(c)) {
-            silhouette_of(c, light, &mut out);
+        for (_, s) in self.silhouettes(light, keep) {
+            out.edges.extend(s.edges);
+            out.lit_faces.extend(s.lit_faces);
         }
         out
     }
@@ -123,15 +124,7 @@ impl Casters {
     /// The silhouette of each caster `keep` accepts, with the caster.
     #[must_use]
     pub fn silhouettes(&self, light: &LightShape, mut keep: impl FnMut(&Caster) -> bool) -> Vec<(&Caster, Silhouette)> {
-        self.casters
-            .iter()
-            .filter(|c| keep(c))
-            .map(|c| {
-                let mut s = Silhouette::default();
-                silhouette_of(c, light, &mut s);
-                (c, s)
-            })
-            .collect()
+        self.casters.iter().filter(|c| keep(c)).map(|c| (c, silhouette_of(c, light))).collect()
     }
 }
 
@@ -144,7 +137,8 @@ fn facing(n: Vec3, a: Vec3, light: &LightShape) -> f32 {
     }
 }
 
-fn silhouette_of(c: &Caster, light: &LightShape, out: &mut Silhouette) {
+fn silhouette_of(c: &Caster, light: &LightShape) -> Silhouette {
+    let mut out = Silhouette::default();
     // net directed count per undirected edge: +1 per lit face winding it low -> high
     let mut net: HashMap<(u32, u32), i32> = HashMap::new();
     for &[a, b, cc] in &c.triangles {
@@ -172,6 +166,7 @@ fn silhouette_of(c: &Caster, light: &LightShape, out: &mut Silhouette) {
             out.edges.push([c.positions[a as usize], c.positions[b as usize]]);
         }
     }
+    out
 }
 
 #[cfg(test)]

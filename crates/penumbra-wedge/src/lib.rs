@@ -29,7 +29,7 @@ pub mod geometry;
 use casters::{Caster, Casters};
 use geometry::reach_along;
 use glam::{Mat4, Vec3};
-use gpu::accumulate::{Accumulator, Resolve, ResolvePass};
+use gpu::accumulate::{Accumulator, ResolvePass};
 use gpu::{Gpu, GpuError, LightShape, Receivers, ShadowPassReport, ShadowTechnique};
 use wgpu::util::DeviceExt;
 
@@ -73,6 +73,10 @@ pub struct Wedges {
     wedge: wgpu::RenderPipeline,
     resolve: ResolvePass,
 }
+
+/// The WGSL library of this crate's shaders (`// requires:` names).
+const LIBRARY: &[(&str, &str)] =
+    &[("penumbra-wedge/light.wgsl", include_str!("../../../shaders/penumbra-wedge/light.wgsl"))];
 
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -124,7 +128,7 @@ impl Wedges {
             lo = lo.min(c.bounds.0 - Vec3::splat(c.bounds.1));
             hi = hi.max(c.bounds.0 + Vec3::splat(c.bounds.1));
         }
-        let module = |label, src| gpu::shader::module(&gpu.device, label, src, &[]);
+        let module = |label, src| gpu::shader::module(&gpu.device, label, src, LIBRARY);
         let volume_module = module("shadow volume", include_str!("../../../shaders/penumbra-wedge/volume.wgsl"));
         let wedge_module = module("wedges", include_str!("../../../shaders/penumbra-wedge/wedge.wgsl"));
         let pipeline = |label, m: &wgpu::ShaderModule, layout: wgpu::VertexBufferLayout<'_>| {
@@ -169,7 +173,13 @@ impl Wedges {
                 attributes: &wgpu::vertex_attr_array![0 => Float32x2, 1 => Uint32, 2 => Uint32],
             },
         );
-        Self { casters, bounds: (lo, hi), settings, volume, wedge, resolve: ResolvePass::new(gpu) }
+        let resolve = ResolvePass::with_shader(
+            gpu,
+            "wedge resolve",
+            include_str!("../../../shaders/penumbra-wedge/resolve.wgsl"),
+            LIBRARY,
+        );
+        Self { casters, bounds: (lo, hi), settings, volume, wedge, resolve }
     }
 
     /// The casters (which are closed, which cast as sheets).
@@ -353,7 +363,9 @@ impl ShadowTechnique for Wedges {
                     pass.draw(0..footprints.len() as u32, 0..1);
                 }
             }
-            self.resolve.record(gpu, encoder, gb, &acc, Resolve::Wedges(*light), target);
+            let normal = gb.geometric_normal.create_view(&Default::default());
+            let extra = [(3, wgpu::BindingResource::TextureView(&normal))];
+            self.resolve.record(gpu, encoder, gb, &acc, bytemuck::cast_slice(&light_params), &extra, target);
         })?;
         Ok(ShadowPassReport {
             time,

@@ -5,39 +5,46 @@
 use crate::mapper::{ShadowMapper, VisibilityTarget};
 use crate::{ShadowLight, ShadowSettings, Technique, shadow_triangles};
 use glam::Vec3;
-use gpu::accumulate::{Accumulator, Resolve, ResolvePass};
+use gpu::accumulate::{Accumulator, ResolvePass};
 use gpu::{Gpu, GpuError, LightShape, Receivers, ShadowGeometry, ShadowPassReport, ShadowTechnique};
+use std::rc::Rc;
 use std::time::Duration;
 
-/// A shadow-map technique for one scene.
+/// A shadow-map technique for one scene: one setting of shared pipelines and geometry
+/// ([`MapTechnique::variant`] makes others without rebuilding them).
 pub struct MapTechnique {
-    mapper: ShadowMapper,
-    triangles: Vec<[Vec3; 3]>,
-    geometry: ShadowGeometry,
+    shared: Rc<Shared>,
     technique: Technique,
     settings: ShadowSettings,
     samples: u32,
+}
+
+/// What every setting of a scene's maps shares: pipelines and geometry.
+struct Shared {
+    mapper: ShadowMapper,
+    triangles: Vec<[Vec3; 3]>,
+    geometry: ShadowGeometry,
     resolve: ResolvePass,
 }
 
 /// `n` directions spread over the cone of half-angle `half_angle` about `axis`, uniform in
-/// solid angle: a Vogel spiral (the centre alone for n = 1).
+/// solid angle: a Vogel spiral through the cone's own sampling (`DistantLight::sample_direction`);
+/// the centre alone for n = 1.
 #[must_use]
 pub fn cone_directions(axis: Vec3, half_angle: f32, n: u32) -> Vec<Vec3> {
     let axis = axis.normalize_or(Vec3::Y);
     if n <= 1 {
         return vec![axis];
     }
-    let cos_max = half_angle.clamp(0.0, std::f32::consts::FRAC_PI_2).cos();
-    let (t, b) = axis.any_orthonormal_pair();
+    let cone = scene::DistantLight {
+        direction: axis,
+        solid_angle: std::f32::consts::TAU * (1.0 - half_angle.clamp(0.0, std::f32::consts::FRAC_PI_2).cos()),
+        radiance: Vec3::ZERO,
+    };
+    // the golden angle as a fraction of a turn
+    let turn = 0.381_966_f32;
     (0..n)
-        .map(|k| {
-            let u = (k as f32 + 0.5) / n as f32;
-            let cos = 1.0 - u * (1.0 - cos_max);
-            let sin = (1.0 - cos * cos).max(0.0).sqrt();
-            let (s, c) = (k as f32 * 2.399_963).sin_cos();
-            (axis * cos + (t * c + b * s) * sin).normalize()
-        })
+        .map(|k| cone.sample_direction(glam::Vec2::new((k as f32 + 0.5) / n as f32, (k as f32 * turn).fract())).0)
         .collect()
 }
 
@@ -56,21 +63,20 @@ impl MapTechnique {
     ) -> Result<Self, GpuError> {
         let triangles = gpu::scene_triangles(scene);
         let geometry = ShadowGeometry::upload(gpu, &triangles, ShadowGeometry::CHUNK_TRIANGLES)?;
-        Ok(Self {
-            mapper: ShadowMapper::new(gpu),
-            triangles,
-            geometry,
-            technique,
-            settings,
-            samples: samples.max(1),
-            resolve: ResolvePass::new(gpu),
-        })
+        let shared = Shared { mapper: ShadowMapper::new(gpu), triangles, geometry, resolve: ResolvePass::new(gpu) };
+        Ok(Self { shared: Rc::new(shared), technique, settings, samples: samples.max(1) })
+    }
+
+    /// Another setting on the same scene, sharing this one's pipelines and geometry.
+    #[must_use]
+    pub fn variant(&self, technique: Technique, settings: ShadowSettings, samples: u32) -> Self {
+        Self { shared: Rc::clone(&self.shared), technique, settings, samples: samples.max(1) }
     }
 
     /// The shadow mapper (its pipelines).
     #[must_use]
     pub fn mapper(&self) -> &ShadowMapper {
-        &self.mapper
+        &self.shared.mapper
     }
 }
 
@@ -117,37 +123,39 @@ impl ShadowTechnique for MapTechnique {
         };
         let subdivided;
         let geometry = if self.technique == Technique::DualParaboloid && settings.subdivide_angle.is_some() {
-            let t = shadow_triangles(&self.triangles, &lights[0], self.technique, &settings);
+            let t = shadow_triangles(&self.shared.triangles, &lights[0], self.technique, &settings);
             subdivided = ShadowGeometry::upload(gpu, &t, ShadowGeometry::CHUNK_TRIANGLES)?;
             &subdivided
         } else {
-            &self.geometry
+            &self.shared.geometry
         };
         let mut time = Duration::ZERO;
         let mut clock = None;
         let mut primitives = 0u64;
         let acc = if lights.len() > 1 { Some(Accumulator::new(gpu, receivers.gbuffer.size())?) } else { None };
         for (k, l) in lights.iter().enumerate() {
-            let map = self.mapper.render(gpu, geometry, l, self.technique, &settings)?;
+            let map = self.shared.mapper.render(gpu, geometry, l, self.technique, &settings)?;
             primitives += u64::from(map.triangles_drawn());
             let out = match &acc {
                 Some(a) => VisibilityTarget::Add(a, k == 0),
                 None => VisibilityTarget::Layer(target),
             };
             let (t, c) = gpu.measure(|encoder| {
-                self.mapper.record_visibility(gpu, encoder, &map, receivers.gbuffer, out, half_angle);
+                self.shared.mapper.record_visibility(gpu, encoder, &map, receivers.gbuffer, out, half_angle);
             })?;
             time += map.time + t;
             clock = Some(c);
         }
         if let Some(a) = &acc {
             let (t, _) = gpu.measure(|encoder| {
-                self.resolve.record(
+                let scale = [1.0 / lights.len() as f32, 0.0, 0.0, 0.0];
+                self.shared.resolve.record(
                     gpu,
                     encoder,
                     receivers.gbuffer,
                     a,
-                    Resolve::Scale(1.0 / lights.len() as f32),
+                    bytemuck::cast_slice(&scale),
+                    &[],
                     target,
                 );
             })?;

@@ -75,16 +75,15 @@ fn techniques(gpu: &Gpu, scene: &scene::Scene, plan: &Plan) -> Result<Vec<NamedT
     let hard = plan.shadow;
     let pcss = ShadowSettings { pcss: Some(Pcss::default()), pcf_radius: 0, ..hard };
     let multi = ShadowSettings { resolution: hard.resolution / 2, pcf_radius: 0, ..hard };
+    let maps = MapTechnique::new(gpu, scene, Technique::Orthographic, hard, 1).map_err(e)?;
+    let (pcss, multi) = (
+        maps.variant(Technique::Orthographic, pcss, 1),
+        maps.variant(Technique::Orthographic, multi, plan.multi_samples),
+    );
     Ok(vec![
-        (
-            "gpu_shadow_maps".into(),
-            Box::new(MapTechnique::new(gpu, scene, Technique::Orthographic, hard, 1).map_err(e)?),
-        ),
-        ("gpu_pcss".into(), Box::new(MapTechnique::new(gpu, scene, Technique::Orthographic, pcss, 1).map_err(e)?)),
-        (
-            format!("gpu_shadow_maps_x{}", plan.multi_samples),
-            Box::new(MapTechnique::new(gpu, scene, Technique::Orthographic, multi, plan.multi_samples).map_err(e)?),
-        ),
+        ("gpu_shadow_maps".into(), Box::new(maps)),
+        ("gpu_pcss".into(), Box::new(pcss)),
+        (format!("gpu_shadow_maps_x{}", plan.multi_samples), Box::new(multi)),
         ("gpu_wedges".into(), Box::new(Wedges::new(gpu, scene, WedgeSettings::default()))),
     ])
 }
