@@ -5,7 +5,7 @@
 
 use glam::Vec3;
 use gpu::{GBufferPass, Gpu, GpuError, LightShape, Receivers, SceneGeometry, ShadowTechnique, Visibility};
-use penumbra_wedge::{WedgeSettings, Wedges};
+use penumbra_wedge::{WedgePath, WedgeSettings, Wedges};
 use ref_tracer::SceneBvh;
 use ref_tracer::visibility::{AreaLight, area_light_visibility_refined};
 use shadowmap_paraboloid::{MapTechnique, Pcss, ShadowSettings, Technique};
@@ -27,14 +27,15 @@ pub fn light(half_angle_degrees: f32) -> LightShape {
 
 /// A named technique with the knob it sweeps.
 pub struct Entry {
-    /// Family: `wedges`, `pcss`, `shadow_maps_xN`, `shadow_maps`.
+    /// Family: `wedges`, `wedges_compute`, `pcss`, `shadow_maps_xN`, `shadow_maps`.
     pub family: &'static str,
     /// The technique.
     pub technique: Box<dyn ShadowTechnique>,
 }
 
-/// Every technique and setting of the sweep for `scene`: wedges; one hard 2048² map with 3 × 3
-/// PCF; PCSS on 2048² maps with 8, 32 and 64 filter samples; the mean of 4, 16 and 64 1024² maps.
+/// Every technique and setting of the sweep for `scene`: wedges (raster and tiled compute); one
+/// hard 2048² map with 3 × 3 PCF; PCSS on 2048² maps with 8, 32 and 64 filter samples; the mean
+/// of 4, 16 and 64 1024² maps.
 ///
 /// # Errors
 /// GPU failures.
@@ -44,6 +45,14 @@ pub fn entries(gpu: &Gpu, scene: &scene::Scene) -> Result<Vec<Entry>, GpuError> 
     let map = |settings: ShadowSettings, n: u32| Box::new(maps.variant(Technique::Orthographic, settings, n));
     let mut out = vec![
         Entry { family: "wedges", technique: Box::new(Wedges::new(gpu, scene, WedgeSettings::default())) },
+        Entry {
+            family: "wedges_compute",
+            technique: Box::new(Wedges::new(
+                gpu,
+                scene,
+                WedgeSettings { path: WedgePath::Compute, ..Default::default() },
+            )),
+        },
         Entry { family: "shadow_maps", technique: map(hard, 1) },
     ];
     for filter_samples in [8, 32, 64] {

@@ -1,13 +1,17 @@
 // requires: penumbra-wedge/light.wgsl gpu/fullscreen.wgsl
 // Resolve of the wedges' accumulator into a visibility layer: V = clamp(1 - w + g, 0, 1), w = 1
-// where the hard count r is not 0, divided by the fraction of the light's disk above the
-// surface's own plane (casters the point lies on hide the part below it, which the shading's
-// cone integral already leaves out). Background pixels (G-buffer w < 0) stay lit.
+// where the hard count r is not 0, g the edge terms' sum (the accumulator's g, or `edge_sum`),
+// divided by the fraction of the light's disk above the surface's own plane (casters the point
+// lies on hide the part below it, which the shading's cone integral already leaves out).
+// Background pixels (G-buffer w < 0) stay lit.
 
 @group(0) @binding(0) var<uniform> light: Light;
 @group(0) @binding(1) var g_position: texture_2d<f32>;
 @group(0) @binding(2) var accumulated: texture_2d<f32>;
 @group(0) @binding(3) var g_geometric_normal: texture_2d<f32>;
+// the edge terms' sum of the compute path (tiles.wgsl); a 1 x 1 zero texture for the raster
+// path, whose sum is in the accumulator's g
+@group(0) @binding(4) var edge_sum: texture_2d<f32>;
 
 // Fraction of the light's disk (in the plane the wedges project onto) above the plane through
 // p with normal n.
@@ -33,7 +37,8 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let a = textureLoad(accumulated, pixel, 0);
     // counts are whole numbers: exact in f32 and f16
     let w = select(0.0, 1.0, abs(a.r) > 0.5);
-    let v = clamp(1.0 - w + a.g, 0.0, 1.0);
+    let sum_texel = min(vec2<u32>(pixel), textureDimensions(edge_sum) - vec2<u32>(1u));
+    let v = clamp(1.0 - w + a.g + textureLoad(edge_sum, sum_texel, 0).r, 0.0, 1.0);
     let n = textureLoad(g_geometric_normal, pixel, 0).xyz;
     return vec4<f32>(clamp(v / max(disk_above(g.xyz, n), 1e-4), 0.0, 1.0));
 }

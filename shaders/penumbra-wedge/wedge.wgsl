@@ -1,13 +1,7 @@
-// requires: penumbra-wedge/light.wgsl
+// requires: penumbra-wedge/light.wgsl penumbra-wedge/coverage.wgsl
 // Penumbra wedges: per pixel of a footprint (the conservative hull of a few consecutive
 // silhouette edges' wedges), each edge's signed coverage of the light's disk seen from the
-// G-buffer point, a_e / pi, summed and added to the accumulator's g
-// (`penumbra_wedge::coverage` is the same computation on the CPU; its doc derives it).
-
-struct Edge {
-    v0: vec4<f32>,
-    v1: vec4<f32>,
-}
+// G-buffer point, a_e / pi (coverage.wgsl), summed and added to the accumulator's g.
 
 @group(0) @binding(0) var<uniform> light: Light;
 @group(0) @binding(1) var<storage, read> edges: array<Edge>;
@@ -27,66 +21,6 @@ fn vs(@location(0) ndc: vec2<f32>, @location(1) first: u32, @location(2) count: 
     out.first = first;
     out.count = count;
     return out;
-}
-
-// G(h, s) = atan(s / h) / 2 - h s / 2 over the chord |s| <= sqrt(1 - h^2), constant beyond.
-fn g_term(h: f32, s_in: f32) -> f32 {
-    let c = sqrt(max(1.0 - h * h, 0.0));
-    let s = clamp(s_in, -c, c);
-    var phi = atan2(s, h);
-    if h < 0.0 {
-        phi = -atan2(s, -h);
-    }
-    return 0.5 * phi - 0.5 * h * s;
-}
-
-// a_e / pi of the projected segment q0 -> q1 (unit-disk coordinates).
-fn segment_term(q0: vec2<f32>, q1: vec2<f32>) -> f32 {
-    let d = q1 - q0;
-    let len = length(d);
-    if !(len > 1e-12) || len > 3.0e38 {
-        return 0.0;
-    }
-    let s_hat = d / len;
-    let n_hat = vec2<f32>(s_hat.y, -s_hat.x);
-    let h = dot(q0, n_hat);
-    if abs(h) >= 1.0 {
-        return 0.0;
-    }
-    return (g_term(h, dot(q1, s_hat)) - g_term(h, dot(q0, s_hat))) / PI;
-}
-
-fn edge_term(p: vec3<f32>, f: LightFrame, v0: vec3<f32>, v1: vec3<f32>) -> f32 {
-    let d0 = v0 - p;
-    let d1 = v1 - p;
-    let z0 = dot(d0, f.z);
-    let z1 = dot(d1, f.z);
-    let z_min = 1e-6 * max(length(d0), length(d1));
-    if (z0 < z_min && z1 < z_min) || (z0 > f.z_max && z1 > f.z_max) {
-        return 0.0;
-    }
-    // clip to z_min <= z <= z_max
-    var t0 = 0.0;
-    var t1 = 1.0;
-    let dz = z1 - z0;
-    if z0 < z_min {
-        t0 = clamp((z_min - z0) / dz, 0.0, 1.0);
-    } else if z1 < z_min {
-        t1 = clamp((z_min - z0) / dz, 0.0, 1.0);
-    }
-    if z0 > f.z_max {
-        t0 = max(t0, clamp((f.z_max - z0) / dz, 0.0, 1.0));
-    } else if z1 > f.z_max {
-        t1 = min(t1, clamp((f.z_max - z0) / dz, 0.0, 1.0));
-    }
-    if t0 >= t1 {
-        return 0.0;
-    }
-    let a = d0 + (d1 - d0) * t0;
-    let b = d0 + (d1 - d0) * t1;
-    let qa = vec2<f32>(dot(a, f.x), dot(a, f.y)) / (max(dot(a, f.z), z_min) * f.tan_a);
-    let qb = vec2<f32>(dot(b, f.x), dot(b, f.y)) / (max(dot(b, f.z), z_min) * f.tan_a);
-    return segment_term(qa, qb);
 }
 
 @fragment

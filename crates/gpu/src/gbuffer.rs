@@ -38,6 +38,16 @@ fn view_and_fov(camera: &scene::Camera) -> (f32, f32, Mat4) {
     (2.0 * (tan_half_x / aspect).atan(), aspect, glam::camera::rh::view::look_to_mat4(camera.eye, forward, up))
 }
 
+/// Reversed-Z projection × view with the far plane at infinity (depth = near / distance, 1 at
+/// the near plane, 0 at infinity): a float depth buffer then resolves distances to the same
+/// relative precision near and far. With standard Z over a 100 m ground, a box's front face
+/// lost its bottom pixel rows to the ground 5 mm behind it.
+#[must_use]
+pub fn view_projection_reverse(camera: &scene::Camera, near: f32) -> Mat4 {
+    let (fov_y, aspect, view) = view_and_fov(camera);
+    glam::camera::rh::proj::directx::perspective_infinite_reverse(fov_y, aspect, near) * view
+}
+
 /// As [`view_projection`] with the far plane at infinity: what passes that draw geometry
 /// extruded far beyond the scene (shadow volumes) use, so that no far plane cuts it.
 #[must_use]
@@ -78,7 +88,8 @@ impl GBufferPass {
             depth_stencil: Some(wgpu::DepthStencilState {
                 format: wgpu::TextureFormat::Depth32Float,
                 depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
+                // reversed Z (see `view_projection_reverse`)
+                depth_compare: Some(wgpu::CompareFunction::Greater),
                 stencil: Default::default(),
                 bias: Default::default(),
             }),
@@ -109,13 +120,13 @@ impl GBufferPass {
             depth: target("gbuffer depth", wgpu::TextureFormat::Depth32Float)?,
             camera: *camera,
         };
-        // Near and far planes bracket the scene's bounds as seen from the eye.
+        // The near plane scales with the scene's reach from the eye: no absolute distance, so a
+        // scene scaled by 1e-3 or 1e3 rasterizes the same.
         let (lo, hi) = geometry.bounds;
         let reach = if lo.is_finite() { (hi - lo).length() + camera.eye.distance(0.5 * (lo + hi)) } else { 1.0 };
-        let far = reach.max(1e-3) * 1.01;
-        let near = (far * 1e-5).max(1e-4);
+        let near = (reach * 1e-6).max(f32::MIN_POSITIVE * 1e6);
         let uniform = CameraUniform {
-            view_proj: view_projection(camera, near, far).to_cols_array_2d(),
+            view_proj: view_projection_reverse(camera, near).to_cols_array_2d(),
             eye: Vec3::extend(camera.eye, 1.0).to_array(),
         };
         let buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -151,7 +162,7 @@ impl GBufferPass {
                 color_attachments: &attachments,
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                     view: &depth_view,
-                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Store }),
                     stencil_ops: None,
                 }),
                 timestamp_writes: None,

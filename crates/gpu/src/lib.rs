@@ -24,12 +24,15 @@ mod technique;
 mod timer;
 
 pub use context::{ADAPTER_ENV, Gpu, GpuError, adapters, describe_adapter, pick_adapter};
-pub use gbuffer::{GBUFFER_FORMAT, GBuffer, GBufferPass, view_projection, view_projection_infinite};
+pub use gbuffer::{
+    GBUFFER_FORMAT, GBuffer, GBufferPass, view_projection, view_projection_infinite, view_projection_reverse,
+};
 pub use geometry::{Chunk, SceneGeometry, ShadowGeometry, scene_triangles};
 pub use readback::{read_texture_f32, read_texture_rgba};
 pub use shade::{Background, HDR_FORMAT, ShadeLight, ShadeParams, ShadingPass, Visibility, downsample_box};
 pub use target::{layer_view, render_target};
 pub use technique::{
-    LightShape, PrecomputedVisibility, Receivers, ShadowPassReport, ShadowTechnique, render_visibility, totals,
+    LightShape, PrecomputedVisibility, Receivers, ShadowPassReport, ShadowTechnique, WEBER_FRACTION,
+    WEBER_MAX_RECEIVERS, render_visibility, totals, weber_negligible,
 };
 pub use timer::Clock;

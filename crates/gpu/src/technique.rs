@@ -5,7 +5,8 @@
 //! report iterate over techniques through it.
 //!
 //! [`render_visibility`] is the frame loop every caller shares: it skips lights that no visible
-//! receiver can see (no shadow pass for a light nobody sees) and reports what it skipped.
+//! receiver can see (no shadow pass for a light nobody sees), and those [`weber_negligible`]
+//! finds below Weber's 2 % at every visible receiver, and reports what it skipped.
 
 use crate::context::{Gpu, GpuError};
 use crate::gbuffer::GBuffer;
@@ -166,7 +167,8 @@ pub trait ShadowTechnique {
 }
 
 /// Writes every light's layer of `visibility` with `technique`, skipping lights that no visible
-/// receiver faces (their layers stay lit: the shading pass gives them nothing there anyway).
+/// receiver faces (their layers stay lit: the shading pass gives them nothing there anyway) and
+/// lights marked in `negligible` (e.g. by [`weber_negligible`]; an empty slice marks none).
 ///
 /// # Errors
 /// [`GpuError::TooLarge`] when `visibility` has fewer layers than lights; the technique's
@@ -176,6 +178,7 @@ pub fn render_visibility(
     technique: &dyn ShadowTechnique,
     receivers: &Receivers,
     lights: &[LightShape],
+    negligible: &[bool],
     visibility: &Visibility,
 ) -> Result<Vec<ShadowPassReport>, GpuError> {
     if lights.len() as u64 > u64::from(visibility.layers()) {
@@ -194,9 +197,82 @@ pub fn render_visibility(
             });
             continue;
         }
+        if negligible.get(k).copied().unwrap_or(false) {
+            out.push(ShadowPassReport {
+                skipped: Some(format!("below Weber's {:.0} % at every visible receiver", WEBER_FRACTION * 100.0)),
+                ..ShadowPassReport::default()
+            });
+            continue;
+        }
         out.push(technique.write_visibility(gpu, receivers, light, &visibility.layer(k as u32))?);
     }
     Ok(out)
+}
+
+/// Weber's fraction: a change of luminance below 2 % of what a surface already receives is not
+/// seen (as `light_extract::Weber` uses it for extraction).
+pub const WEBER_FRACTION: f32 = 0.02;
+
+/// Receivers [`weber_negligible`] looks at, at most: a regular subset of the G-buffer's points
+/// (every k-th pixel in x and y), so the test costs the same whatever the image size.
+pub const WEBER_MAX_RECEIVERS: usize = 1 << 16;
+
+/// For each light, whether its unshadowed irradiance is below `fraction` of the receiver's
+/// whole unshadowed irradiance (all lights and the ambient's SH9) at every visible receiver
+/// that faces it: its shadow, at most that light, changes no pixel by a visible amount, so it
+/// needs no shadow pass. Luminance; the diffuse lobe (a small light's glossy highlight can stand
+/// out more than its irradiance says: pass a lower fraction for glossy scenes). Looks at most at
+/// [`WEBER_MAX_RECEIVERS`] points of a regular subset of the image: a light that matters only
+/// between them can be skipped. Non-finite irradiance marks nothing negligible.
+#[must_use]
+pub fn weber_negligible(
+    receivers: &Receivers,
+    lights: &[crate::shade::ShadeLight],
+    ambient: Option<&envmap_sphere::Sh9>,
+    fraction: f32,
+) -> Vec<bool> {
+    use crate::shade::ShadeLight;
+    let luminance = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+    let (w, h) = receivers.gbuffer.size();
+    let pixels = (w as usize * h as usize).max(1);
+    let stride = ((pixels as f64 / WEBER_MAX_RECEIVERS as f64).sqrt().ceil() as usize).max(1);
+    let mut negligible = vec![true; lights.len()];
+    let mut e = vec![0f32; lights.len()];
+    for y in (0..h as usize).step_by(stride) {
+        for x in (0..w as usize).step_by(stride) {
+            let Some(&(p, n)) = receivers.points.get(y * w as usize + x) else { continue };
+            if !p.is_finite() {
+                continue;
+            }
+            let mut total = ambient.map_or(0.0, |a| luminance(a.irradiance(n)).max(0.0));
+            for (ek, light) in e.iter_mut().zip(lights) {
+                *ek = match *light {
+                    ShadeLight::Distant { direction, irradiance, half_angle } => {
+                        let sin = half_angle.sin();
+                        let solid_angle = std::f32::consts::TAU * (1.0 - half_angle.cos());
+                        let integral = if sin > 1e-3 {
+                            scene::cone_cosine_integral(n.dot(direction.normalize_or_zero()), half_angle) / solid_angle
+                        } else {
+                            n.dot(direction.normalize_or_zero()).max(0.0)
+                        };
+                        luminance(irradiance) * integral
+                    }
+                    ShadeLight::Point { position, intensity } => {
+                        let d = position - p;
+                        let d2 = d.length_squared().max(f32::MIN_POSITIVE);
+                        luminance(intensity) * (n.dot(d) / d2.sqrt()).max(0.0) / d2
+                    }
+                };
+                total += *ek;
+            }
+            for (k, ek) in e.iter().enumerate() {
+                if !(ek.is_finite() && total.is_finite()) || *ek >= fraction * total {
+                    negligible[k] = false;
+                }
+            }
+        }
+    }
+    negligible
 }
 
 /// Totals over a frame's reports: (GPU time, lights shadowed, lights skipped, primitives).

@@ -289,3 +289,123 @@ fn wide_cones_shade_as_the_ray_traced_cone() {
         }
     }
 }
+
+/// The G-buffer sees what primary rays through the pixel centres hit: a box standing on a 100 m
+/// ground (depth spans 1e4), the camera at a 2 × 2 supersampled validate size. With standard Z
+/// and a near plane at 1e-5 of the scene's reach, the ground 5 mm behind the box's front face
+/// won the depth test along the face's bottom rows; reversed Z resolves it, and scaled scenes
+/// rasterize the same.
+#[test]
+fn gbuffer_objects_are_the_primary_rays_hits_at_every_scale() {
+    let gpu = gpu();
+    for scale in [1e-3f32, 1.0, 1e3] {
+        let scene = Scene {
+            name: "box on a wide ground".into(),
+            objects: vec![
+                Object {
+                    name: "ground".into(),
+                    mesh: Mesh::quad(
+                        Vec3::new(-50.0, 0.0, 50.0) * scale,
+                        Vec3::new(100.0, 0.0, 0.0) * scale,
+                        Vec3::new(0.0, 0.0, -100.0) * scale,
+                        1,
+                        1,
+                    ),
+                    material: Material::lambert(0.5),
+                },
+                Object {
+                    name: "box".into(),
+                    mesh: Mesh::cuboid(Vec3::new(0.5, 0.0, -0.5) * scale, Vec3::new(1.5, 2.0, 0.5) * scale),
+                    material: Material::lambert(0.8),
+                },
+            ],
+            camera: Camera {
+                eye: Vec3::new(0.5, 2.5, 7.0) * scale,
+                target: Vec3::new(0.0, 0.9, 0.0) * scale,
+                up: Vec3::Y,
+                hfov_degrees: 40.0,
+                width: 1280,
+                height: 960,
+            },
+            point_lights: vec![],
+        };
+        let geometry = SceneGeometry::upload(&gpu, &scene).unwrap();
+        let gb = GBufferPass::new(&gpu).render(&gpu, &geometry, &scene.camera).unwrap();
+        let positions = gb.read_positions(&gpu).unwrap();
+        let bvh = SceneBvh::new(&scene);
+        let rays = scene.camera.rays();
+        let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
+        let mut box_pixels = 0;
+        let mismatched: Vec<(usize, usize)> = (0..w * h)
+            .filter(|&k| {
+                let (x, y) = (k % w, k / w);
+                let (o, d) = rays.ray(x as f32 + 0.5, y as f32 + 0.5);
+                let hit = bvh.intersect(o, d, f32::INFINITY).map_or(-1.0, |s| s.object as f32);
+                box_pixels += usize::from(hit == 1.0);
+                positions[k][3] != hit
+            })
+            .map(|k| (k % w, k / w))
+            .collect();
+        assert!(box_pixels > 50_000, "scale {scale}: the box covers {box_pixels} pixels");
+        // a pixel centre within rounding of a silhouette may go either way: a few, not a row
+        assert!(
+            mismatched.len() <= 8,
+            "scale {scale}: {} pixels differ, e.g. {:?}",
+            mismatched.len(),
+            &mismatched[..8.min(mismatched.len())]
+        );
+    }
+}
+
+/// Weber's law on a floor and a wall: a light 1 % of the sun is negligible where the sun lights
+/// every receiver, but a dim light that alone lights the wall's far side is not; the ambient
+/// counts towards what receivers already get; a light no receiver faces gives 0 everywhere, so
+/// it is negligible too (render_visibility names the other reason first).
+#[test]
+fn weber_negligible_lights_are_below_two_percent_at_every_receiver() {
+    let gpu = gpu();
+    let scene = Scene {
+        name: "floor and wall".into(),
+        objects: vec![
+            Object {
+                name: "floor".into(),
+                mesh: Mesh::quad(Vec3::new(-4.0, 0.0, 4.0), Vec3::new(8.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -8.0), 1, 1),
+                material: Material::lambert(0.5),
+            },
+            Object {
+                name: "wall".into(),
+                mesh: Mesh::cuboid(Vec3::new(-0.1, 0.0, -1.0), Vec3::new(0.1, 2.0, 1.0)),
+                material: Material::lambert(0.5),
+            },
+        ],
+        camera: camera(Vec3::new(3.0, 4.0, 6.0), Vec3::new(0.0, 0.5, 0.0), 128, 96),
+        point_lights: vec![],
+    };
+    let geometry = SceneGeometry::upload(&gpu, &scene).unwrap();
+    let gb = GBufferPass::new(&gpu).render(&gpu, &geometry, &scene.camera).unwrap();
+    let points = gb.read_points(&gpu).unwrap();
+    let receivers = gpu::Receivers::new(&gb, &points);
+    let cone = |d: Vec3, e: f32, half: f32| ShadeLight::Distant {
+        direction: d.normalize(),
+        irradiance: Vec3::splat(e),
+        half_angle: half,
+    };
+    // the sun overhead, slightly to -x: it lights the floor and the wall's top and -x side
+    let lights = [
+        cone(Vec3::new(-0.3, 1.0, 0.1), 100.0, 0.01),
+        cone(Vec3::new(-0.3, 1.0, 0.1), 1.0, 0.2), // 1 % of the sun, where the sun shines
+        cone(Vec3::new(1.0, 0.05, 0.0), 1.0, 0.05), // alone on the wall's +x side
+        cone(Vec3::new(-0.3, -1.0, -0.3), 1e6, 0.05), // from below: no visible receiver faces it
+    ];
+    let negligible = gpu::weber_negligible(&receivers, &lights, None, gpu::WEBER_FRACTION);
+    assert!(points.iter().filter(|(p, n)| p.is_finite() && n.x > 0.9).count() > 100, "the wall's +x side is seen");
+    assert_eq!(negligible, [false, true, false, true]);
+    // with a bright ambient, the lone light on the wall is under 2 % there too
+    let bright = Sh9::project(&EnvMap::from_fn(32, 16, |_| Vec3::splat(100.0)));
+    let negligible = gpu::weber_negligible(&receivers, &lights, Some(&bright), gpu::WEBER_FRACTION);
+    assert_eq!(negligible, [false, true, true, true]);
+    // non-finite light marks nothing negligible
+    let mut huge = lights;
+    huge[0] = cone(Vec3::Y, f32::INFINITY, 0.01);
+    assert!(gpu::weber_negligible(&receivers, &huge, None, gpu::WEBER_FRACTION).iter().all(|n| !n));
+}

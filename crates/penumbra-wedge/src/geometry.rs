@@ -164,9 +164,10 @@ pub fn points_meet_box(points: &[Vec3], (lo, hi): (Vec3, Vec3)) -> bool {
 }
 
 /// The screen footprint (NDC triangles) of the convex hull of `points` under `view_proj`,
-/// clipped to view depths of at least `near` (no receiver is nearer) and to the screen; nothing
-/// when it lies off screen or behind the eye. Clipping a convex hull by a plane keeps the points
-/// in front and the crossings of every segment between a point in front and one behind.
+/// clipped to view depths of at least `near` (no receiver is nearer) and to the screen with a
+/// margin ([`SCREEN_MARGIN`]); nothing when it lies off screen or behind the eye. Clipping a
+/// convex hull by a plane keeps the points in front and the crossings of every segment between
+/// a point in front and one behind.
 #[must_use]
 pub fn footprint(points: &[Vec3], view_proj: &Mat4, near: f32) -> Vec<[Vec2; 3]> {
     let clip: Vec<glam::Vec4> = points.iter().map(|p| *view_proj * p.extend(1.0)).collect();
@@ -186,15 +187,23 @@ pub fn footprint(points: &[Vec3], view_proj: &Mat4, near: f32) -> Vec<[Vec2; 3]>
     (1..hull.len() - 1).map(|k| [hull[0], hull[k], hull[k + 1]]).collect()
 }
 
-/// A convex polygon clipped to the screen square [-1, 1]² (Sutherland-Hodgman).
+/// How far past the screen's edges ([-1, 1]² in NDC) footprints are clipped: a hull whose
+/// near-plane crossings project to NDC of 1e7 and more meets the screen's edges after rounding
+/// errors of that size's ulps, which lost whole rows of border pixels before (a compute-path
+/// test found them); the margin keeps such rounding off screen. Pixels are not drawn twice.
+pub const SCREEN_MARGIN: f32 = 0.05;
+
+/// A convex polygon clipped to the screen square widened by [`SCREEN_MARGIN`]
+/// (Sutherland-Hodgman, in f64: the crossings of huge coordinates keep their precision).
 fn clip_to_screen(poly: &[Vec2]) -> Vec<Vec2> {
-    let mut out = poly.to_vec();
-    for (axis, sign) in [(0, 1.0f32), (0, -1.0), (1, 1.0), (1, -1.0)] {
+    let mut out: Vec<glam::DVec2> = poly.iter().map(|p| p.as_dvec2()).collect();
+    let edge = 1.0 + f64::from(SCREEN_MARGIN);
+    for (axis, sign) in [(0, 1.0f64), (0, -1.0), (1, 1.0), (1, -1.0)] {
         if out.is_empty() {
             break;
         }
-        // keep sign * p[axis] <= 1
-        let inside = |p: Vec2| sign * p[axis] <= 1.0;
+        // keep sign * p[axis] <= edge
+        let inside = |p: glam::DVec2| sign * p[axis] <= edge;
         let input = std::mem::take(&mut out);
         for k in 0..input.len() {
             let (a, b) = (input[k], input[(k + 1) % input.len()]);
@@ -202,12 +211,12 @@ fn clip_to_screen(poly: &[Vec2]) -> Vec<Vec2> {
                 out.push(a);
             }
             if inside(a) != inside(b) {
-                let t = (sign - a[axis]) / (b[axis] - a[axis]);
+                let t = (sign * edge - a[axis]) / (b[axis] - a[axis]);
                 out.push(a + (b - a) * t);
             }
         }
     }
-    out
+    out.into_iter().map(|p| p.as_vec2()).collect()
 }
 
 /// Silhouette edges ordered into chains (each edge's end is the next one's start where the
@@ -329,7 +338,7 @@ mod tests {
         assert!(area > 0.0 && area < 2.0, "area {area} of the screen's 4");
         for t in &tris {
             for v in t {
-                assert!(v.x <= -0.0 && v.abs().max_element() <= 1.0 + 1e-5, "{v}");
+                assert!(v.x <= -0.0 && v.abs().max_element() <= 1.0 + SCREEN_MARGIN + 1e-5, "{v}");
             }
         }
         // wholly behind the eye: nothing

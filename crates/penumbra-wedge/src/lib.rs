@@ -33,6 +33,18 @@ use gpu::accumulate::{Accumulator, ResolvePass};
 use gpu::{Gpu, GpuError, LightShape, Receivers, ShadowPassReport, ShadowTechnique};
 use wgpu::util::DeviceExt;
 
+/// How wedges reach the pixels they cover.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum WedgePath {
+    /// Footprints rasterized, one fragment per pixel and footprint (paper 000's way).
+    #[default]
+    Raster,
+    /// Footprints binned into 16 × 16 screen tiles on the CPU, every pixel of a tile summing
+    /// its tile's edges in one compute invocation (`shaders/penumbra-wedge/tiles.wgsl`): no
+    /// blending, one write per pixel, more edge terms evaluated (the whole tile's).
+    Compute,
+}
+
 /// Knobs of the wedges.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct WedgeSettings {
@@ -42,13 +54,73 @@ pub struct WedgeSettings {
     /// Consecutive silhouette edges drawn under one footprint (the hull of their wedges): fewer,
     /// larger footprints, each pixel looping over the group's edges. 1 is one wedge per edge.
     pub edges_per_footprint: u32,
+    /// Raster or tiled compute (the hard volume is rasterized either way).
+    pub path: WedgePath,
 }
 
 impl Default for WedgeSettings {
-    /// Culling on, 8 edges per footprint.
+    /// Culling on, 8 edges per footprint, the raster path.
     fn default() -> Self {
-        Self { cull: true, edges_per_footprint: 8 }
+        Self { cull: true, edges_per_footprint: 8, path: WedgePath::Raster }
     }
+}
+
+/// Side of the compute path's screen tiles, pixels (`tiles.wgsl`'s workgroup size).
+pub const TILE: u32 = 16;
+
+/// The compute path's bins: per tile of [`TILE`] × [`TILE`] pixels (row-major, `tiles_x` per
+/// row), the range of its entries in `groups`; each entry is a footprint's edge range
+/// `(first, count)`. A footprint is binned into every tile its triangles' screen bounds touch,
+/// once per tile.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct TileBins {
+    /// Tiles per row.
+    pub tiles_x: u32,
+    /// Per tile: (first entry, entry count).
+    pub ranges: Vec<[u32; 2]>,
+    /// Edge ranges `(first, count)` of the binned footprints.
+    pub groups: Vec<[u32; 2]>,
+}
+
+/// Bins `footprints` (NDC triangles with their edge range, as [`WedgePlan::footprints`]) into
+/// the tiles of a `width` × `height` image.
+#[must_use]
+pub fn bin_footprints(footprints: &[([glam::Vec2; 3], u32, u32)], (width, height): (u32, u32)) -> TileBins {
+    let tiles_x = width.div_ceil(TILE).max(1);
+    let tiles_y = height.div_ceil(TILE).max(1);
+    let n_tiles = (tiles_x * tiles_y) as usize;
+    // per footprint, the tiles it touches (a footprint's triangles are consecutive)
+    let mut per_tile: Vec<Vec<[u32; 2]>> = vec![Vec::new(); n_tiles];
+    let mut last: Vec<Option<u32>> = vec![None; n_tiles];
+    for (tri, first, count) in footprints {
+        if !tri.iter().all(|v| v.is_finite()) {
+            continue;
+        }
+        let px = tri.map(|v| glam::Vec2::new((v.x + 1.0) * 0.5 * width as f32, (1.0 - v.y) * 0.5 * height as f32));
+        let lo = px[0].min(px[1]).min(px[2]);
+        let hi = px[0].max(px[1]).max(px[2]);
+        if hi.x < 0.0 || hi.y < 0.0 || lo.x >= width as f32 || lo.y >= height as f32 {
+            continue;
+        }
+        let tile = |v: f32, n: u32| ((v.max(0.0) / TILE as f32) as u32).min(n - 1);
+        let (x0, x1) = (tile(lo.x, tiles_x), tile(hi.x, tiles_x));
+        let (y0, y1) = (tile(lo.y, tiles_y), tile(hi.y, tiles_y));
+        for ty in y0..=y1 {
+            for tx in x0..=x1 {
+                let t = (ty * tiles_x + tx) as usize;
+                if last[t] != Some(*first) {
+                    last[t] = Some(*first);
+                    per_tile[t].push([*first, *count]);
+                }
+            }
+        }
+    }
+    let mut bins = TileBins { tiles_x, ranges: Vec::with_capacity(n_tiles), groups: Vec::new() };
+    for list in per_tile {
+        bins.ranges.push([bins.groups.len() as u32, list.len() as u32]);
+        bins.groups.extend(list);
+    }
+    bins
 }
 
 /// What the GPU draws for one light, built on the CPU.
@@ -71,12 +143,17 @@ pub struct Wedges {
     settings: WedgeSettings,
     volume: wgpu::RenderPipeline,
     wedge: wgpu::RenderPipeline,
+    tiles: wgpu::ComputePipeline,
     resolve: ResolvePass,
+    // the resolve's edge sum where the raster path leaves it in the accumulator
+    no_edge_sum: wgpu::Texture,
 }
 
 /// The WGSL library of this crate's shaders (`// requires:` names).
-const LIBRARY: &[(&str, &str)] =
-    &[("penumbra-wedge/light.wgsl", include_str!("../../../shaders/penumbra-wedge/light.wgsl"))];
+const LIBRARY: &[(&str, &str)] = &[
+    ("penumbra-wedge/light.wgsl", include_str!("../../../shaders/penumbra-wedge/light.wgsl")),
+    ("penumbra-wedge/coverage.wgsl", include_str!("../../../shaders/penumbra-wedge/coverage.wgsl")),
+];
 
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -91,6 +168,20 @@ struct FootprintVertex {
 struct ViewUniform {
     view_proj: [[f32; 4]; 4],
     eye: [f32; 4],
+}
+
+/// The compute path's R32Float sum of edge terms (zero-initialized).
+fn edge_sum_texture(gpu: &Gpu, (w, h): (u32, u32)) -> wgpu::Texture {
+    gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("wedge edge sum"),
+        size: wgpu::Extent3d { width: w.max(1), height: h.max(1), depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::R32Float,
+        usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
+        view_formats: &[],
+    })
 }
 
 /// Whether the segment from `a` to `b` meets the box `(lo, hi)`.
@@ -179,7 +270,17 @@ impl Wedges {
             include_str!("../../../shaders/penumbra-wedge/resolve.wgsl"),
             LIBRARY,
         );
-        Self { casters, bounds: (lo, hi), settings, volume, wedge, resolve }
+        let tiles_module = module("wedge tiles", include_str!("../../../shaders/penumbra-wedge/tiles.wgsl"));
+        let tiles = gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("wedge tiles"),
+            layout: None,
+            module: &tiles_module,
+            entry_point: Some("main"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        let no_edge_sum = edge_sum_texture(gpu, (1, 1));
+        Self { casters, bounds: (lo, hi), settings, volume, wedge, tiles, resolve, no_edge_sum }
     }
 
     /// The casters (which are closed, which cast as sheets).
@@ -273,7 +374,11 @@ impl Wedges {
 
 impl ShadowTechnique for Wedges {
     fn name(&self) -> String {
-        if self.settings.cull { "wedges".into() } else { "wedges_unculled".into() }
+        let path = match self.settings.path {
+            WedgePath::Raster => "",
+            WedgePath::Compute => "_compute",
+        };
+        format!("wedges{path}{}", if self.settings.cull { "" } else { "_unculled" })
     }
 
     fn supports(&self, _light: &LightShape) -> bool {
@@ -343,6 +448,35 @@ impl ShadowTechnique for Wedges {
             ],
         });
         let acc = Accumulator::new(gpu, gb.size())?;
+        let compute = (self.settings.path == WedgePath::Compute).then(|| {
+            let (w, h) = gb.size();
+            let bins = bin_footprints(&plan.footprints, (w, h));
+            let tiles = [w, h, bins.tiles_x, 0];
+            let mut groups = bins.groups;
+            if groups.is_empty() {
+                groups.push([0, 0]);
+            }
+            let sum = edge_sum_texture(gpu, (w, h));
+            let sum_view = sum.create_view(&Default::default());
+            let tiles_buf = buffer("wedge tiles", bytemuck::cast_slice(&tiles), wgpu::BufferUsages::UNIFORM);
+            let ranges_buf =
+                buffer("wedge tile ranges", bytemuck::cast_slice(&bins.ranges), wgpu::BufferUsages::STORAGE);
+            let groups_buf = buffer("wedge tile groups", bytemuck::cast_slice(&groups), wgpu::BufferUsages::STORAGE);
+            let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("wedge tiles"),
+                layout: &self.tiles.get_bind_group_layout(0),
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: light_buf.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: edge_buf.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&position) },
+                    wgpu::BindGroupEntry { binding: 3, resource: tiles_buf.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 4, resource: ranges_buf.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 5, resource: groups_buf.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::TextureView(&sum_view) },
+                ],
+            });
+            (sum, bind, (bins.tiles_x, h.div_ceil(TILE).max(1)))
+        });
         let (time, clock) = gpu.measure(|encoder| {
             {
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -356,15 +490,26 @@ impl ShadowTechnique for Wedges {
                     pass.set_vertex_buffer(0, vb.slice(..));
                     pass.draw(0..volume.len() as u32, 0..1);
                 }
-                if let Some(fb) = &footprint_buf {
+                if let (Some(fb), None) = (&footprint_buf, &compute) {
                     pass.set_pipeline(&self.wedge);
                     pass.set_bind_group(0, &wedge_bind, &[]);
                     pass.set_vertex_buffer(0, fb.slice(..));
                     pass.draw(0..footprints.len() as u32, 0..1);
                 }
             }
+            if let Some((_, bind, (tx, ty))) = &compute {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("wedge tiles"),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(&self.tiles);
+                pass.set_bind_group(0, bind, &[]);
+                pass.dispatch_workgroups(*tx, *ty, 1);
+            }
             let normal = gb.geometric_normal.create_view(&Default::default());
-            let extra = [(3, wgpu::BindingResource::TextureView(&normal))];
+            let sum = compute.as_ref().map_or(&self.no_edge_sum, |(t, _, _)| t).create_view(&Default::default());
+            let extra =
+                [(3, wgpu::BindingResource::TextureView(&normal)), (4, wgpu::BindingResource::TextureView(&sum))];
             self.resolve.record(gpu, encoder, gb, &acc, bytemuck::cast_slice(&light_params), &extra, target);
         })?;
         Ok(ShadowPassReport {
@@ -374,5 +519,50 @@ impl ShadowTechnique for Wedges {
             primitives: (plan.volume.len() + plan.footprints.len()) as u64,
             culled: plan.culled,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec2;
+
+    /// Every pixel a footprint triangle covers lies in a tile that lists the footprint, once;
+    /// tiles it cannot touch do not; off-screen and non-finite triangles bin nowhere.
+    #[test]
+    fn footprints_bin_into_the_tiles_they_touch_once() {
+        let (w, h) = (100u32, 70u32);
+        let ndc = |x: f32, y: f32| Vec2::new(x / w as f32 * 2.0 - 1.0, 1.0 - y / h as f32 * 2.0);
+        let footprints = vec![
+            // group (0, 3): two triangles of one quad over pixels 20..40 x 5..30
+            ([ndc(20.0, 5.0), ndc(40.0, 5.0), ndc(40.0, 30.0)], 0, 3),
+            ([ndc(20.0, 5.0), ndc(40.0, 30.0), ndc(20.0, 30.0)], 0, 3),
+            // group (3, 1): a sliver in the last tiles, partly off screen
+            ([ndc(95.0, 65.0), ndc(130.0, 66.0), ndc(96.0, 90.0)], 3, 1),
+            // off screen and non-finite: nowhere
+            ([ndc(-50.0, -50.0), ndc(-10.0, -50.0), ndc(-10.0, -5.0)], 4, 2),
+            ([Vec2::NAN, ndc(1.0, 1.0), ndc(2.0, 2.0)], 6, 1),
+        ];
+        let bins = bin_footprints(&footprints, (w, h));
+        assert_eq!((bins.tiles_x, bins.ranges.len()), (7, 7 * 5));
+        let listed = |tx: u32, ty: u32| {
+            let [first, count] = bins.ranges[(ty * bins.tiles_x + tx) as usize];
+            bins.groups[first as usize..(first + count) as usize].to_vec()
+        };
+        for ty in 0..5 {
+            for tx in 0..7 {
+                let quad = (1..=2).contains(&tx) && ty <= 1;
+                let sliver = tx == 5 && ty == 4 || tx == 6 && ty == 4;
+                let mut want = Vec::new();
+                if quad {
+                    want.push([0, 3]);
+                }
+                if sliver {
+                    want.push([3, 1]);
+                }
+                assert_eq!(listed(tx, ty), want, "tile ({tx}, {ty})");
+            }
+        }
+        assert!(bin_footprints(&[], (w, h)).groups.is_empty());
     }
 }

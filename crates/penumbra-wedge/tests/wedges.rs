@@ -7,7 +7,7 @@
 
 use glam::Vec3;
 use gpu::{GBufferPass, Gpu, LightShape, Receivers, SceneGeometry, ShadowTechnique, Visibility};
-use penumbra_wedge::{WedgeSettings, Wedges, coverage};
+use penumbra_wedge::{WedgePath, WedgeSettings, Wedges, coverage};
 use ref_tracer::SceneBvh;
 use ref_tracer::visibility::{AreaLight, VisibilityLight, area_light_visibility, light_visibility};
 use scene::Scene;
@@ -38,11 +38,15 @@ struct Frame {
 }
 
 fn render(scene: Scene, light: LightShape) -> Frame {
+    render_with(scene, light, WedgeSettings::default())
+}
+
+fn render_with(scene: Scene, light: LightShape, settings: WedgeSettings) -> Frame {
     let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
     let geometry = SceneGeometry::upload(&gpu, &scene).unwrap();
     let gb = GBufferPass::new(&gpu).render(&gpu, &geometry, &scene.camera).unwrap();
     let points = gb.read_points(&gpu).unwrap();
-    let technique = Wedges::new(&gpu, &scene, WedgeSettings::default());
+    let technique = Wedges::new(&gpu, &scene, settings);
     let (w, h) = gb.size();
     let vis = Visibility::new(&gpu, w, h, 1).unwrap();
     let report = technique.write_visibility(&gpu, &Receivers::new(&gb, &points), &light, &vis.layer(0)).unwrap();
@@ -265,4 +269,36 @@ fn overlapping_casters_are_counted_twice_where_both_cover_the_light() {
     assert!(mean < 0.015 && soft_mean < 0.2, "mean {mean}, in penumbrae {soft_mean}");
     let (mirror, _, _, _) = compare(&f.wedges, &f.mirror(&light), 0.05);
     assert!(mirror < 0.002, "GPU against its CPU mirror: {mirror}");
+}
+
+/// The tiled compute path writes what the raster path writes: the same edge terms, summed per
+/// pixel over its tile's footprints instead of per rasterized footprint (R8Unorm layers: equal
+/// to a unit in the last place where float sums round differently), for distant lights small
+/// and huge, a local light, culled or not, the camera inside a volume, and one edge per
+/// footprint. (The camera-in-a-volume case found raster footprints losing the screen's top row
+/// to rounding when clipped at the eye's plane; `geometry::SCREEN_MARGIN` is the fix.)
+#[test]
+fn compute_path_writes_the_raster_paths_visibility() {
+    let local = LightShape::Sphere { center: Vec3::new(0.5, 3.0, 1.0), radius: 0.3 };
+    // the eye in the middle box's shadow (camera_inside_a_shadow_volume's setting)
+    let mut inside = scene("three_boxes", 160, 120);
+    (inside.camera.eye, inside.camera.target) = (Vec3::new(0.0, 0.3, -2.2), Vec3::new(0.0, 0.2, 3.0));
+    let across = LightShape::Distant { direction: Vec3::new(0.0, 1.0, 1.0).normalize(), half_angle: 0.3 };
+    let cases = [
+        ("three_boxes", scene("three_boxes", 160, 120), sun(4.0), 8, true),
+        ("spheres_box", scene("spheres_box", 160, 120), sun(16.0), 8, true),
+        ("column 45", scene("column", 160, 120), sun(45.0), 1, false),
+        ("local", scene("three_boxes", 160, 120), local, 8, true),
+        ("camera in a volume", inside, across, 8, true),
+    ];
+    for (what, s, light, edges_per_footprint, cull) in cases {
+        let settings = |path| WedgeSettings { cull, edges_per_footprint, path };
+        let raster = render_with(s.clone(), light, settings(WedgePath::Raster));
+        let compute = render_with(s, light, settings(WedgePath::Compute));
+        let soft = raster.wedges.iter().filter(|v| **v > 0.02 && **v < 0.98).count();
+        assert!(soft > 20, "{what}: {soft} penumbra pixels");
+        let worst = raster.wedges.iter().zip(&compute.wedges).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+        assert!(worst <= 1.5 / 255.0, "{what}: layers differ by up to {worst}");
+        assert_eq!(raster.report.culled, compute.report.culled, "{what}");
+    }
 }

@@ -8,7 +8,8 @@ use envmap_sphere::EnvMap;
 use glam::Vec3;
 use gpu::{
     Background, GBufferPass, Gpu, LightShape, PrecomputedVisibility, Receivers, SceneGeometry, ShadeLight, ShadeParams,
-    ShadingPass, ShadowGeometry, ShadowTechnique, Visibility, downsample_box, render_visibility,
+    ShadingPass, ShadowGeometry, ShadowTechnique, Visibility, WEBER_FRACTION, downsample_box, render_visibility,
+    weber_negligible,
 };
 use penumbra_wedge::{WedgeSettings, Wedges};
 use ref_tracer::SceneBvh;
@@ -124,18 +125,21 @@ pub(super) fn gpu_render(
         "gpu_traced_visibility".into(),
         Box::new(traced_visibility(gpu, scene, &receivers, &shapes, plan.truth_directions)?),
     ));
+    // lights whose shadow no visible receiver could tell apart (Weber's law) get no pass
+    let negligible = weber_negligible(&receivers, &lights, Some(&d.ambient_sh), WEBER_FRACTION);
     for (name, technique) in all {
         let t = Instant::now();
         let vis = Visibility::new(gpu, w, h, lights.len() as u32).map_err(e)?;
-        let reports = render_visibility(gpu, technique.as_ref(), &receivers, &shapes, &vis).map_err(e)?;
+        let reports = render_visibility(gpu, technique.as_ref(), &receivers, &shapes, &negligible, &vis).map_err(e)?;
         let image = downsample_box(&pass.render(gpu, &geometry, &gb, &params, &vis).map_err(e)?, size, ss);
-        let (time, shadowed, skipped, _) = gpu::totals(&reports);
+        let (time, shadowed, _, _) = gpu::totals(&reports);
         let shadow_ms = time.as_secs_f64() * 1e3;
         out.push(GpuImage {
             what: format!(
-                "GPU: {} lights with {} ({shadowed} shadowed, {skipped} skipped: no visible receiver faces them; {shadow_ms:.1} ms), + SH9 ambient",
+                "GPU: {} lights with {} ({shadowed} shadowed{}; {shadow_ms:.1} ms), + SH9 ambient",
                 lights.len(),
                 technique.name(),
+                skip_summary(&reports),
             ),
             name,
             image,
@@ -151,6 +155,18 @@ pub(super) fn gpu_render(
         seconds: 0.0,
     });
     Ok(out)
+}
+
+/// ", N skipped: why" per reason, or nothing.
+fn skip_summary(reports: &[gpu::ShadowPassReport]) -> String {
+    let mut reasons: Vec<(&str, usize)> = Vec::new();
+    for r in reports.iter().filter_map(|r| r.skipped.as_deref()) {
+        match reasons.iter_mut().find(|(w, _)| *w == r) {
+            Some((_, n)) => *n += 1,
+            None => reasons.push((r, 1)),
+        }
+    }
+    reasons.iter().map(|(why, n)| format!(", {n} skipped: {why}")).collect()
 }
 
 pub(super) type MaskImages = (Vec<f32>, Vec<f32>, Vec<Option<bool>>, (u32, u32));

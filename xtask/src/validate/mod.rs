@@ -2,7 +2,7 @@
 //! given ones): decompose the map with EmissiveSplit (or `--method`), render the lights on the GPU with
 //! orthographic shadow maps (and without shadows), render the `ref-tracer` references, measure
 //! the `room` point light's paraboloid and cube shadow maps against ray-traced visibility and
-//! time them, write `target/validate/report.html` (self-contained), and fail when an error
+//! time them, write `target/validate/report.html` (self-contained) and each image as EXR beside it, and fail when an error
 //! exceeds its threshold in `validate/thresholds.json`.
 
 mod gpu_stages;
@@ -101,7 +101,7 @@ impl Plan {
                 repeats: 7,
                 multi_samples: 16,
                 truth_directions: 8,
-                gpu_supersample: 2,
+                gpu_supersample: 3,
             }
         }
     }
@@ -297,6 +297,11 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
     };
     let path = args.out.join("report.html");
     std::fs::write(&path, report.html(&args.out)?).map_err(|e| format!("{}: {e}", path.display()))?;
+    // every image as linear EXR beside the report, for `cargo xtask compare` and viewers
+    for r in &rows {
+        let exr = args.out.join(format!("{}.exr", r.name));
+        envmap_sphere::io::save_exr_rgb(&exr, w as usize, h as usize, &r.image).map_err(|e| e.to_string())?;
+    }
     for r in &rows {
         if let (Some(rm), Some(fl)) = (r.rmse, r.flip) {
             outln!("  {:<18} RMSE {rm:.4}  FLIP {fl:.4}  {:.2} s", r.name, r.seconds);
