@@ -552,7 +552,7 @@ mod tests {
         for ty in 0..5 {
             for tx in 0..7 {
                 let quad = (1..=2).contains(&tx) && ty <= 1;
-                let sliver = tx == 5 && ty == 4 || tx == 6 && ty == 4;
+                let sliver = (5..=6).contains(&tx) && ty == 4;
                 let mut want = Vec::new();
                 if quad {
                     want.push([0, 3]);
