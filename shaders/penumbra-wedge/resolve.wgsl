@@ -1,6 +1,6 @@
 // requires: penumbra-wedge/light.wgsl gpu/fullscreen.wgsl
-// Resolve of the wedges' accumulator into a visibility layer: V = clamp(1 - w + g, 0, 1), w = 1
-// where the hard count r is not 0, g the edge terms' sum (the accumulator's g, or `edge_sum`),
+// Resolve of the wedges' accumulator into a visibility layer: V = clamp(1 - w + g, 0, 1), w the
+// hard count r (the number of shadow volumes the point lies in), g the edge terms' sum (the accumulator's g, or `edge_sum`),
 // divided by the fraction of the light's disk above the surface's own plane (casters the point
 // lies on hide the part below it, which the shading's cone integral already leaves out).
 // Background pixels (G-buffer w < 0) stay lit.
@@ -36,7 +36,10 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     }
     let a = textureLoad(accumulated, pixel, 0);
     // counts are whole numbers: exact in f32 and f16
-    let w = select(0.0, 1.0, abs(a.r) > 0.5);
+    // every volume the point lies in hides the light's centre once: where casters overlap, their
+    // occlusions add (clamped below) instead of the second caster's edges lighting the first's
+    // umbra (`coverage::visibility` says why)
+    let w = abs(round(a.r));
     let sum_texel = min(vec2<u32>(pixel), textureDimensions(edge_sum) - vec2<u32>(1u));
     let v = clamp(1.0 - w + a.g + textureLoad(edge_sum, sum_texel, 0).r, 0.0, 1.0);
     let n = textureLoad(g_geometric_normal, pixel, 0).xyz;

@@ -6,7 +6,7 @@
 //!
 //! [`render_visibility`] is the frame loop every caller shares: it skips lights that no visible
 //! receiver can see (no shadow pass for a light nobody sees), and those [`weber_negligible`]
-//! finds below Weber's 2 % at every visible receiver, and reports what it skipped.
+//! finds below Weber's 2 % at every visible receiver, together, and reports what it skipped.
 
 use crate::context::{Gpu, GpuError};
 use crate::gbuffer::GBuffer;
@@ -199,7 +199,10 @@ pub fn render_visibility(
         }
         if negligible.get(k).copied().unwrap_or(false) {
             out.push(ShadowPassReport {
-                skipped: Some(format!("below Weber's {:.0} % at every visible receiver", WEBER_FRACTION * 100.0)),
+                skipped: Some(format!(
+                    "under Weber's {:.0} % of every visible receiver's light, with the others skipped",
+                    WEBER_FRACTION * 100.0
+                )),
                 ..ShadowPassReport::default()
             });
             continue;
@@ -217,11 +220,16 @@ pub const WEBER_FRACTION: f32 = 0.02;
 /// (every k-th pixel in x and y), so the test costs the same whatever the image size.
 pub const WEBER_MAX_RECEIVERS: usize = 1 << 16;
 
-/// For each light, whether its unshadowed irradiance is below `fraction` of the receiver's
-/// whole unshadowed irradiance (all lights and the ambient's SH9) at every visible receiver
-/// that faces it: its shadow, at most that light, changes no pixel by a visible amount, so it
-/// needs no shadow pass. Luminance; the diffuse lobe (a small light's glossy highlight can stand
-/// out more than its irradiance says: pass a lower fraction for glossy scenes). Looks at most at
+/// Which lights need no shadow pass by Weber's law: a set of lights whose unshadowed
+/// irradiance, **summed**, stays below `fraction` of the receiver's whole unshadowed irradiance
+/// (all lights and the ambient's SH9) at every visible receiver. Their shadows together change
+/// no pixel by a visible amount. A per-light test alone would not do: on
+/// `st_fagans_interior_1k.hdr` it skipped lights each under 2 % that together made the
+/// ray-traced truth row's RMSE 9 % worse. Lights are taken greedily, faintest (by their largest
+/// share anywhere) first, while the sum fits at every receiver.
+///
+/// Luminance; the diffuse lobe (a small light's glossy highlight can stand out more than its
+/// irradiance says: pass a lower fraction for glossy scenes). Looks at most at
 /// [`WEBER_MAX_RECEIVERS`] points of a regular subset of the image: a light that matters only
 /// between them can be skipped. Non-finite irradiance marks nothing negligible.
 #[must_use]
@@ -236,40 +244,57 @@ pub fn weber_negligible(
     let (w, h) = receivers.gbuffer.size();
     let pixels = (w as usize * h as usize).max(1);
     let stride = ((pixels as f64 / WEBER_MAX_RECEIVERS as f64).sqrt().ceil() as usize).max(1);
-    let mut negligible = vec![true; lights.len()];
-    let mut e = vec![0f32; lights.len()];
-    for y in (0..h as usize).step_by(stride) {
-        for x in (0..w as usize).step_by(stride) {
-            let Some(&(p, n)) = receivers.points.get(y * w as usize + x) else { continue };
-            if !p.is_finite() {
-                continue;
+    let points: Vec<(Vec3, Vec3)> = (0..h as usize)
+        .step_by(stride)
+        .flat_map(|y| (0..w as usize).step_by(stride).map(move |x| y * w as usize + x))
+        .filter_map(|k| receivers.points.get(k).copied())
+        .filter(|(p, _)| p.is_finite())
+        .collect();
+    let irradiance = |light: &ShadeLight, (p, n): (Vec3, Vec3)| match *light {
+        ShadeLight::Distant { direction, irradiance, half_angle } => {
+            let solid_angle = std::f32::consts::TAU * (1.0 - half_angle.cos());
+            let cos = n.dot(direction.normalize_or_zero());
+            let mean_cos = if half_angle.sin() > 1e-3 {
+                scene::cone_cosine_integral(cos, half_angle) / solid_angle
+            } else {
+                cos.max(0.0)
+            };
+            luminance(irradiance) * mean_cos
+        }
+        ShadeLight::Point { position, intensity } => {
+            let d = position - p;
+            let d2 = d.length_squared().max(f32::MIN_POSITIVE);
+            luminance(intensity) * (n.dot(d) / d2.sqrt()).max(0.0) / d2
+        }
+    };
+    let totals: Vec<f32> = points
+        .iter()
+        .map(|&pn| {
+            ambient.map_or(0.0, |a| luminance(a.irradiance(pn.1)).max(0.0))
+                + lights.iter().map(|l| irradiance(l, pn)).sum::<f32>()
+        })
+        .collect();
+    if !totals.iter().all(|t| t.is_finite()) {
+        return vec![false; lights.len()];
+    }
+    // each light's largest share of a receiver's irradiance: the order of the greedy pass
+    let share = |light: &ShadeLight, (k, &pn): (usize, &(Vec3, Vec3))| irradiance(light, pn) / totals[k].max(1e-30);
+    let mut order: Vec<(usize, f32)> = lights
+        .iter()
+        .enumerate()
+        .map(|(i, l)| (i, points.iter().enumerate().map(|r| share(l, r)).fold(0.0f32, f32::max)))
+        .filter(|(_, s)| *s < fraction)
+        .collect();
+    order.sort_by(|a, b| a.1.total_cmp(&b.1));
+    let mut negligible = vec![false; lights.len()];
+    let mut skipped_share = vec![0f32; points.len()];
+    for (i, _) in order {
+        let add: Vec<f32> = points.iter().enumerate().map(|r| share(&lights[i], r)).collect();
+        if add.iter().zip(&skipped_share).all(|(a, s)| a + s < fraction) {
+            for (s, a) in skipped_share.iter_mut().zip(add) {
+                *s += a;
             }
-            let mut total = ambient.map_or(0.0, |a| luminance(a.irradiance(n)).max(0.0));
-            for (ek, light) in e.iter_mut().zip(lights) {
-                *ek = match *light {
-                    ShadeLight::Distant { direction, irradiance, half_angle } => {
-                        let sin = half_angle.sin();
-                        let solid_angle = std::f32::consts::TAU * (1.0 - half_angle.cos());
-                        let integral = if sin > 1e-3 {
-                            scene::cone_cosine_integral(n.dot(direction.normalize_or_zero()), half_angle) / solid_angle
-                        } else {
-                            n.dot(direction.normalize_or_zero()).max(0.0)
-                        };
-                        luminance(irradiance) * integral
-                    }
-                    ShadeLight::Point { position, intensity } => {
-                        let d = position - p;
-                        let d2 = d.length_squared().max(f32::MIN_POSITIVE);
-                        luminance(intensity) * (n.dot(d) / d2.sqrt()).max(0.0) / d2
-                    }
-                };
-                total += *ek;
-            }
-            for (k, ek) in e.iter().enumerate() {
-                if !(ek.is_finite() && total.is_finite()) || *ek >= fraction * total {
-                    negligible[k] = false;
-                }
-            }
+            negligible[i] = true;
         }
     }
     negligible

@@ -359,7 +359,8 @@ fn gbuffer_objects_are_the_primary_rays_hits_at_every_scale() {
 
 /// Weber's law on a floor and a wall: a light 1 % of the sun is negligible where the sun lights
 /// every receiver, but a dim light that alone lights the wall's far side is not; the ambient
-/// counts towards what receivers already get; a light no receiver faces gives 0 everywhere, so
+/// counts towards what receivers already get; skipped lights share the 2 % (ten lights of
+/// 1.5 % each: one is skipped); a light no receiver faces gives 0 everywhere, so
 /// it is negligible too (render_visibility names the other reason first).
 #[test]
 fn weber_negligible_lights_are_below_two_percent_at_every_receiver() {
@@ -404,6 +405,11 @@ fn weber_negligible_lights_are_below_two_percent_at_every_receiver() {
     let bright = Sh9::project(&EnvMap::from_fn(32, 16, |_| Vec3::splat(100.0)));
     let negligible = gpu::weber_negligible(&receivers, &lights, Some(&bright), gpu::WEBER_FRACTION);
     assert_eq!(negligible, [false, true, true, true]);
+    // ten lights of 1.5 % each where the sun shines: one fits under 2 %, not all ten
+    let mut many = vec![cone(Vec3::new(-0.3, 1.0, 0.1), 100.0, 0.01)];
+    many.extend((0..10).map(|_| cone(Vec3::new(-0.3, 1.0, 0.1), 1.5 * 100.0 / 85.0, 0.01)));
+    let negligible = gpu::weber_negligible(&receivers, &many, None, gpu::WEBER_FRACTION);
+    assert_eq!(negligible.iter().filter(|n| **n).count(), 1, "{negligible:?}");
     // non-finite light marks nothing negligible
     let mut huge = lights;
     huge[0] = cone(Vec3::Y, f32::INFINITY, 0.01);

@@ -66,22 +66,31 @@ impl Frame {
         area_light_visibility(&SceneBvh::new(&self.scene), &self.points, area(light), 32)
     }
 
-    /// The CPU mirror: the same silhouette, the hard term from a ray to the light's centre.
+    /// The CPU mirror: the same silhouette, the hard count from a ray to the light's centre per
+    /// caster (the test scenes' casters are convex: a ray crosses each volume at most once).
     fn mirror(&self, light: &LightShape) -> Vec<Option<f32>> {
         let casters = penumbra_wedge::casters::Casters::new(&self.scene);
         let sil = casters.silhouette(light, |_| true);
-        let bvh = SceneBvh::new(&self.scene);
         let centre = match *light {
             LightShape::Distant { direction, .. } => VisibilityLight::Distant(direction),
             LightShape::Sphere { center, .. } => VisibilityLight::Point(center),
         };
-        let hard = light_visibility(&bvh, &self.points, centre);
+        let mut counts: Vec<Option<u32>> = vec![Some(0); self.points.len()];
+        for object in &self.scene.objects {
+            let alone = Scene { objects: vec![object.clone()], ..self.scene.clone() };
+            let lit = light_visibility(&SceneBvh::new(&alone), &self.points, centre);
+            for (c, l) in counts.iter_mut().zip(lit) {
+                *c = match (*c, l) {
+                    (Some(c), Some(l)) => Some(c + u32::from(!l)),
+                    _ => None,
+                };
+            }
+        }
         self.points
             .iter()
-            .zip(hard)
-            .map(|(&(p, n), lit)| {
-                let lit = lit?;
-                let v = coverage::visibility(p, &sil.edges, !lit, light);
+            .zip(counts)
+            .map(|(&(p, n), count)| {
+                let v = coverage::visibility(p, &sil.edges, count?, light);
                 Some((v / coverage::disk_above(p, n, light).max(1e-4)).clamp(0.0, 1.0))
             })
             .collect()
@@ -245,10 +254,11 @@ fn shadows_that_miss_the_view_cull_their_wedges() {
 #[test]
 fn overlapping_casters_are_counted_twice_where_both_cover_the_light() {
     // two stacked boxes (closed casters) one above the other: from the ground below, both
-    // silhouettes cover the light's disk, so their edge terms add; the wedge sum clamps, but
-    // where both partly cover it, it darkens too much. The artefact, measured on lavapipe: mean
-    // error 0.14 in penumbrae (0.007 over all pixels), against 0.002-0.014 for single casters;
-    // the CPU mirror has it too (the method, not the GPU code).
+    // silhouettes cover the light's disk, so their edge terms add; where both partly cover it,
+    // the disk's overlap is occluded twice and it darkens too much. The artefact, measured on
+    // lavapipe: mean error 0.107 in penumbrae (0.005 over all pixels; 0.142 and 0.007 with
+    // paper 000's hard term min(count, 1)), against 0.002-0.014 for single casters; the CPU
+    // mirror has it too (the method, not the GPU code).
     let mut s = scene("three_boxes", 160, 120);
     s.objects.truncate(1);
     for (k, (lo, hi)) in
@@ -266,7 +276,7 @@ fn overlapping_casters_are_counted_twice_where_both_cover_the_light() {
     let f = render(s, light);
     let (mean, soft_mean, _, soft) = compare(&f.wedges, &f.truth(&light), 0.05);
     assert!(soft > 100, "{soft}");
-    assert!(mean < 0.015 && soft_mean < 0.2, "mean {mean}, in penumbrae {soft_mean}");
+    assert!(mean < 0.008 && soft_mean < 0.13, "mean {mean}, in penumbrae {soft_mean}");
     let (mirror, _, _, _) = compare(&f.wedges, &f.mirror(&light), 0.05);
     assert!(mirror < 0.002, "GPU against its CPU mirror: {mirror}");
 }

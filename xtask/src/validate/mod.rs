@@ -34,7 +34,7 @@ pub struct ValidateArgs {
     /// the default only, other methods' keys carry the method.
     #[arg(long, default_value = "emissive-split")]
     pub method: String,
-    /// Smaller images and fewer samples: about 17 s on 2 cores once built.
+    /// Smaller images and fewer samples: about 40 s on 2 cores once built.
     #[arg(long)]
     pub quick: bool,
     /// Output directory.
