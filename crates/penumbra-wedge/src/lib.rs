@@ -427,7 +427,8 @@ impl ShadowTechnique for Wedges {
         // wgpu refuses empty buffers: a dummy element when there is nothing to draw
         let volume_buf = (!volume.is_empty())
             .then(|| buffer("shadow volume", bytemuck::cast_slice(&volume), wgpu::BufferUsages::VERTEX));
-        let footprint_buf = (!footprints.is_empty())
+        // the compute path bins the footprints instead of drawing them
+        let footprint_buf = (!footprints.is_empty() && self.settings.path == WedgePath::Raster)
             .then(|| buffer("wedge footprints", bytemuck::cast_slice(&footprints), wgpu::BufferUsages::VERTEX));
         let position = gb.position.create_view(&Default::default());
         let volume_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -490,7 +491,7 @@ impl ShadowTechnique for Wedges {
                     pass.set_vertex_buffer(0, vb.slice(..));
                     pass.draw(0..volume.len() as u32, 0..1);
                 }
-                if let (Some(fb), None) = (&footprint_buf, &compute) {
+                if let Some(fb) = &footprint_buf {
                     pass.set_pipeline(&self.wedge);
                     pass.set_bind_group(0, &wedge_bind, &[]);
                     pass.set_vertex_buffer(0, fb.slice(..));
