@@ -38,21 +38,13 @@ struct GBufferOut {
     @location(0) position: vec4<f32>,
     @location(1) normal: vec4<f32>,
     @location(2) geometric_normal: vec4<f32>,
-    @builtin(frag_depth) depth: f32,
 }
-
-// Depth ulps a face seen from behind loses ties by (depth is reversed: smaller is farther):
-// where a closed mesh's back face meets its front face, interpolated depths tie within a few
-// ulps, and the back face, inside the mesh and in its own shadow, must not show through.
-const BACK_FACE_BIAS_ULPS: u32 = 64u;
 
 @fragment
 fn fs(in: VsOut) -> GBufferOut {
     var ng = in.geometric_normal;
-    var depth = in.clip.z;
     if dot(ng, camera.eye.xyz - in.world) < 0.0 {
         ng = -ng;
-        depth = bitcast<f32>(bitcast<u32>(depth) - min(bitcast<u32>(depth), BACK_FACE_BIAS_ULPS));
     }
     var ns = in.normal;
     let len = length(ns);
@@ -64,6 +56,5 @@ fn fs(in: VsOut) -> GBufferOut {
     out.position = vec4<f32>(in.world, f32(in.object));
     out.normal = vec4<f32>(ns, 0.0);
     out.geometric_normal = vec4<f32>(ng, 0.0);
-    out.depth = depth;
     return out;
 }
