@@ -7,6 +7,9 @@
 struct Edge {
     v0: vec4<f32>,
     v1: vec4<f32>,
+    // the normals of the lit face (facing the light) and the unlit one (zero for a sheet)
+    lit: vec4<f32>,
+    unlit: vec4<f32>,
 }
 
 // G(h, s) = atan(s / h) / 2 - h s / 2 over the chord |s| <= sqrt(1 - h^2), constant beyond.
@@ -67,4 +70,15 @@ fn edge_term(p: vec3<f32>, f: LightFrame, v0: vec3<f32>, v1: vec3<f32>) -> f32 {
     let qa = vec2<f32>(dot(a, f.x), dot(a, f.y)) / (max(dot(a, f.z), z_min) * f.tan_a);
     let qb = vec2<f32>(dot(b, f.x), dot(b, f.y)) / (max(dot(b, f.z), z_min) * f.tan_a);
     return segment_term(qa, qb);
+}
+
+// edge_term, negated where p lies in front of the edge's lit face and not in front of its
+// unlit one: a light straddling the lit face's plane is partly hidden by the face's lit side
+// there, and the outline is seen mirrored (`coverage::oriented_edge_term`).
+// A receiver on a face's plane is on the side its normal n points to (coverage::ON_PLANE).
+fn oriented_edge_term(p: vec3<f32>, n: vec3<f32>, f: LightFrame, e: Edge) -> f32 {
+    let t = edge_term(p, f, e.v0.xyz, e.v1.xyz);
+    let d0 = p - e.v0.xyz;
+    let d = d0 + n * (1e-4 * length(d0));
+    return select(t, -t, dot(e.lit.xyz, d) > 0.0 && dot(e.unlit.xyz, d) <= 0.0);
 }

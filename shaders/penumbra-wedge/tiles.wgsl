@@ -20,6 +20,7 @@ struct Tiles {
 // per binned group: (first edge, edge count) in `edges`
 @group(0) @binding(5) var<storage, read> groups: array<vec2<u32>>;
 @group(0) @binding(6) var edge_sum: texture_storage_2d<r32float, write>;
+@group(0) @binding(7) var g_geometric_normal: texture_2d<f32>;
 
 @compute @workgroup_size(16, 16)
 fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(workgroup_id) tile: vec3<u32>) {
@@ -31,12 +32,13 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(workgroup_id) til
     var sum = 0.0;
     if g.w >= 0.0 {
         let f = light_frame(light, g.xyz);
+        let n = textureLoad(g_geometric_normal, pixel, 0).xyz;
         let range = tile_ranges[tile.y * tiles.size.z + tile.x];
         for (var i = range.x; i < range.x + range.y; i++) {
             let group = groups[i];
             for (var k = group.x; k < group.x + group.y; k++) {
                 let e = edges[k];
-                sum += edge_term(g.xyz, f, e.v0.xyz, e.v1.xyz);
+                sum += oriented_edge_term(g.xyz, n, f, e);
             }
         }
     }

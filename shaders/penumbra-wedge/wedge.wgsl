@@ -6,6 +6,7 @@
 @group(0) @binding(0) var<uniform> light: Light;
 @group(0) @binding(1) var<storage, read> edges: array<Edge>;
 @group(0) @binding(2) var g_position: texture_2d<f32>;
+@group(0) @binding(3) var g_geometric_normal: texture_2d<f32>;
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
@@ -26,6 +27,7 @@ fn vs(@location(0) ndc: vec2<f32>, @location(1) first: u32, @location(2) count: 
 @fragment
 fn fs(in: VsOut) -> @location(0) vec4<f32> {
     let g = textureLoad(g_position, vec2<i32>(in.clip.xy), 0);
+    let n = textureLoad(g_geometric_normal, vec2<i32>(in.clip.xy), 0).xyz;
     if g.w < 0.0 {
         discard;
     }
@@ -33,7 +35,7 @@ fn fs(in: VsOut) -> @location(0) vec4<f32> {
     var sum = 0.0;
     for (var k = in.first; k < in.first + in.count; k++) {
         let e = edges[k];
-        sum += edge_term(g.xyz, f, e.v0.xyz, e.v1.xyz);
+        sum += oriented_edge_term(g.xyz, n, f, e);
     }
     return vec4<f32>(0.0, sum, 0.0, 0.0);
 }

@@ -9,7 +9,11 @@
 //! layers cover the light and the wedge sum counts them twice (clamped; the overlap artefact).
 //!
 //! Silhouette edges are oriented as their lit face winds, so that seen from the light the lit
-//! region lies to their left; the hard volume and the wedges use that one orientation.
+//! region lies to their left; the hard volume and the wedges use that one orientation. Each edge
+//! keeps the normals of its lit and unlit face: a receiver in front of the lit face and behind
+//! the unlit one (a light straddling the lit face's plane, e.g. the ground and a light at the
+//! horizon) sees the edge's outline mirrored, and the wedge term flips its sign there
+//! (`coverage::oriented_edge_term`).
 
 use glam::Vec3;
 use gpu::LightShape;
@@ -91,6 +95,10 @@ pub struct Casters {
 pub struct Silhouette {
     /// Oriented silhouette edges (lit region to the left seen from the light).
     pub edges: Vec<[Vec3; 2]>,
+    /// Per edge (the same order), the unit normals of the lit face it bounds (on the side
+    /// facing the light) and of the unlit face beyond it (zero for a sheet's edge); sums
+    /// normalised where several faces wind it.
+    pub normals: Vec<[Vec3; 2]>,
     /// The faces that cast, wound to face the light: the hard volume's front cap.
     pub lit_faces: Vec<[Vec3; 3]>,
 }
@@ -116,6 +124,7 @@ impl Casters {
         let mut out = Silhouette::default();
         for (_, s) in self.silhouettes(light, keep) {
             out.edges.extend(s.edges);
+            out.normals.extend(s.normals);
             out.lit_faces.extend(s.lit_faces);
         }
         out
@@ -139,8 +148,9 @@ fn facing(n: Vec3, a: Vec3, light: &LightShape) -> f32 {
 
 fn silhouette_of(c: &Caster, light: &LightShape) -> Silhouette {
     let mut out = Silhouette::default();
-    // net directed count per undirected edge: +1 per lit face winding it low -> high
-    let mut net: HashMap<(u32, u32), i32> = HashMap::new();
+    // net directed count per undirected edge: +1 per lit face winding it low -> high, and the
+    // sums of its lit faces' unit normals (facing the light) and its unlit ones'
+    let mut net: HashMap<(u32, u32), (i32, Vec3, Vec3)> = HashMap::new();
     for &[a, b, cc] in &c.triangles {
         let [pa, pb, pc] = [a, b, cc].map(|i| c.positions[i as usize]);
         let f = facing((pb - pa).cross(pc - pa), pa, light);
@@ -149,21 +159,30 @@ fn silhouette_of(c: &Caster, light: &LightShape) -> Silhouette {
         } else if f < 0.0 && !c.closed {
             [a, cc, b]
         } else {
+            let normal = (pb - pa).cross(pc - pa).normalize_or_zero();
+            for (u, v) in [(a, b), (b, cc), (cc, a)] {
+                net.entry((u.min(v), u.max(v))).or_insert((0, Vec3::ZERO, Vec3::ZERO)).2 += normal;
+            }
             continue;
         };
-        out.lit_faces.push(tri.map(|i| c.positions[i as usize]));
+        let face = tri.map(|i| c.positions[i as usize]);
+        let normal = (face[1] - face[0]).cross(face[2] - face[0]).normalize_or_zero();
+        out.lit_faces.push(face);
         for k in 0..3 {
             let (u, v) = (tri[k], tri[(k + 1) % 3]);
-            *net.entry((u.min(v), u.max(v))).or_default() += if u < v { 1 } else { -1 };
+            let e = net.entry((u.min(v), u.max(v))).or_insert((0, Vec3::ZERO, Vec3::ZERO));
+            e.0 += if u < v { 1 } else { -1 };
+            e.1 += normal;
         }
     }
-    let mut keys: Vec<_> = net.into_iter().filter(|&(_, n)| n != 0).collect();
+    let mut keys: Vec<_> = net.into_iter().filter(|&(_, (n, _, _))| n != 0).collect();
     // a fixed order: the GPU sums edge terms in draw order
-    keys.sort_unstable();
-    for ((lo, hi), n) in keys {
+    keys.sort_unstable_by_key(|&(k, _)| k);
+    for ((lo, hi), (n, lit, unlit)) in keys {
         let (a, b) = if n > 0 { (lo, hi) } else { (hi, lo) };
         for _ in 0..n.unsigned_abs() {
             out.edges.push([c.positions[a as usize], c.positions[b as usize]]);
+            out.normals.push([lit.normalize_or_zero(), unlit.normalize_or_zero()]);
         }
     }
     out

@@ -220,9 +220,10 @@ fn clip_to_screen(poly: &[Vec2]) -> Vec<Vec2> {
 }
 
 /// Silhouette edges ordered into chains (each edge's end is the next one's start where the
-/// silhouette continues), so that neighbouring edges can share one footprint.
+/// silhouette continues), so that neighbouring edges can share one footprint: indices into
+/// `edges`.
 #[must_use]
-pub fn chains(edges: &[[Vec3; 2]]) -> Vec<Vec<[Vec3; 2]>> {
+pub fn chains(edges: &[[Vec3; 2]]) -> Vec<Vec<usize>> {
     let key = |p: Vec3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
     let mut by_start: std::collections::HashMap<[u32; 3], Vec<usize>> = std::collections::HashMap::new();
     for (k, e) in edges.iter().enumerate() {
@@ -238,7 +239,7 @@ pub fn chains(edges: &[[Vec3; 2]]) -> Vec<Vec<[Vec3; 2]>> {
         let mut k = first;
         loop {
             used[k] = true;
-            chain.push(edges[k]);
+            chain.push(k);
             let next = by_start.get(&key(edges[k][1])).and_then(|c| c.iter().copied().find(|&j| !used[j]));
             match next {
                 Some(j) => k = j,
@@ -311,7 +312,8 @@ mod tests {
         assert_eq!(c.len(), 1);
         assert_eq!(c[0].len(), sil.edges.len());
         for k in 0..c[0].len() {
-            assert_eq!(c[0][k][1], c[0][(k + 1) % c[0].len()][0], "edge {k} ends where the next starts");
+            let (e, next) = (sil.edges[c[0][k]], sil.edges[c[0][(k + 1) % c[0].len()]]);
+            assert_eq!(e[1], next[0], "edge {k} ends where the next starts");
         }
     }
 

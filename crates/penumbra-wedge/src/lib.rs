@@ -130,6 +130,8 @@ pub struct WedgePlan {
     pub volume: Vec<[Vec3; 3]>,
     /// Silhouette edges with a wedge to draw.
     pub edges: Vec<[Vec3; 2]>,
+    /// Per edge, its lit and unlit faces' normals ([`casters::Silhouette::normals`]).
+    pub normals: Vec<[Vec3; 2]>,
     /// Footprint triangles in NDC with the range of their edges in `edges` (first, count).
     pub footprints: Vec<([glam::Vec2; 3], u32, u32)>,
     /// Work left out, as `(what, how many)`.
@@ -332,11 +334,12 @@ impl Wedges {
                 for group in chain.chunks(self.settings.edges_per_footprint.max(1) as usize) {
                     let mut points = Vec::with_capacity(18 * group.len());
                     let mut edges = Vec::with_capacity(group.len());
-                    for &[a, b] in group {
+                    for &k in group {
+                        let [a, b] = sil.edges[k];
                         match geometry::wedge_hull_points(a, b, light, extent, cull.then_some(rb)) {
                             Some(p) => {
                                 points.extend(p);
-                                edges.push([a, b]);
+                                edges.push(k);
                             }
                             // a distant light's wedge that cannot reach a receiver, or a local
                             // light's edge with an endpoint inside it
@@ -358,7 +361,8 @@ impl Wedges {
                     }
                     let first = plan.edges.len() as u32;
                     let count = edges.len() as u32;
-                    plan.edges.extend(edges);
+                    plan.edges.extend(edges.iter().map(|&k| sil.edges[k]));
+                    plan.normals.extend(edges.iter().map(|&k| sil.normals[k]));
                     plan.footprints.extend(tris.into_iter().map(|t| (t, first, count)));
                 }
             }
@@ -406,10 +410,15 @@ impl ShadowTechnique for Wedges {
                 t.map(|v| FootprintVertex { ndc: v.to_array(), first: *first, count: *count })
             })
             .collect();
-        let mut edges: Vec<[[f32; 4]; 2]> =
-            plan.edges.iter().map(|[a, b]| [a.extend(1.0).to_array(), b.extend(1.0).to_array()]).collect();
+        // `Edge` in coverage.wgsl: the ends and the lit and unlit faces' normals
+        let mut edges: Vec<[[f32; 4]; 4]> = plan
+            .edges
+            .iter()
+            .zip(&plan.normals)
+            .map(|([a, b], [n, m])| [a.extend(1.0), b.extend(1.0), n.extend(0.0), m.extend(0.0)].map(|v| v.to_array()))
+            .collect();
         if edges.is_empty() {
-            edges.push([[0.0; 4]; 2]);
+            edges.push([[0.0; 4]; 4]);
         }
         let buffer = |label, contents: &[u8], usage| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
@@ -431,6 +440,7 @@ impl ShadowTechnique for Wedges {
         let footprint_buf = (!footprints.is_empty() && self.settings.path == WedgePath::Raster)
             .then(|| buffer("wedge footprints", bytemuck::cast_slice(&footprints), wgpu::BufferUsages::VERTEX));
         let position = gb.position.create_view(&Default::default());
+        let normal = gb.geometric_normal.create_view(&Default::default());
         let volume_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("shadow volume"),
             layout: &self.volume.get_bind_group_layout(0),
@@ -446,6 +456,7 @@ impl ShadowTechnique for Wedges {
                 wgpu::BindGroupEntry { binding: 0, resource: light_buf.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 1, resource: edge_buf.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&position) },
+                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&normal) },
             ],
         });
         let acc = Accumulator::new(gpu, gb.size())?;
@@ -474,6 +485,7 @@ impl ShadowTechnique for Wedges {
                     wgpu::BindGroupEntry { binding: 4, resource: ranges_buf.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 5, resource: groups_buf.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::TextureView(&sum_view) },
+                    wgpu::BindGroupEntry { binding: 7, resource: wgpu::BindingResource::TextureView(&normal) },
                 ],
             });
             (sum, bind, (bins.tiles_x, h.div_ceil(TILE).max(1)))
@@ -507,7 +519,6 @@ impl ShadowTechnique for Wedges {
                 pass.set_bind_group(0, bind, &[]);
                 pass.dispatch_workgroups(*tx, *ty, 1);
             }
-            let normal = gb.geometric_normal.create_view(&Default::default());
             let sum = compute.as_ref().map_or(&self.no_edge_sum, |(t, _, _)| t).create_view(&Default::default());
             let extra =
                 [(3, wgpu::BindingResource::TextureView(&normal)), (4, wgpu::BindingResource::TextureView(&sum))];
