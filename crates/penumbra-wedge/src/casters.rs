@@ -159,9 +159,12 @@ fn silhouette_of(c: &Caster, light: &LightShape) -> Silhouette {
         } else if f < 0.0 && !c.closed {
             [a, cc, b]
         } else {
-            let normal = (pb - pa).cross(pc - pa).normalize_or_zero();
-            for (u, v) in [(a, b), (b, cc), (cc, a)] {
-                net.entry((u.min(v), u.max(v))).or_insert((0, Vec3::ZERO, Vec3::ZERO)).2 += normal;
+            // a closed mesh's unlit (or edge-on) face; a sheet has none
+            if c.closed {
+                let normal = (pb - pa).cross(pc - pa).normalize_or_zero();
+                for (u, v) in [(a, b), (b, cc), (cc, a)] {
+                    net.entry((u.min(v), u.max(v))).or_insert((0, Vec3::ZERO, Vec3::ZERO)).2 += normal;
+                }
             }
             continue;
         };
@@ -222,6 +225,13 @@ mod tests {
         for [a, b] in &s.edges {
             assert!((a.y - 1.0).abs() < 1e-6 && (b.y - 1.0).abs() < 1e-6);
         }
+        // lit: the top; unlit: the side face below the edge, facing away from the edge's middle
+        assert_eq!(s.normals.len(), s.edges.len());
+        for ([a, b], [lit, unlit]) in s.edges.iter().zip(&s.normals) {
+            assert!(lit.distance(Vec3::Y) < 1e-6, "{lit}");
+            let out = (0.5 * (*a + *b) - centre).normalize();
+            assert!(unlit.distance(out) < 1e-6, "{unlit} for the edge {a} -> {b}");
+        }
     }
 
     #[test]
@@ -234,6 +244,7 @@ mod tests {
             assert_eq!(s.lit_faces.len(), 18);
             let area: f32 = s.edges.iter().map(|[a, b]| a.cross(*b).dot(d)).sum();
             assert!(area > 0.0, "counter-clockwise seen from the light at {d}: {area}");
+            assert!(s.normals.iter().all(|[lit, unlit]| lit.distance(d) < 1e-6 && *unlit == Vec3::ZERO));
         }
     }
 }
