@@ -76,9 +76,11 @@ fn edge_term(p: vec3<f32>, f: LightFrame, v0: vec3<f32>, v1: vec3<f32>) -> f32 {
 // unlit one: a light straddling the lit face's plane is partly hidden by the face's lit side
 // there, and the outline is seen mirrored (`coverage::oriented_edge_term`).
 // A receiver on a face's plane is on the side its normal n points to (coverage::ON_PLANE).
+const ON_PLANE: f32 = 1e-4;
+
 fn oriented_edge_term(p: vec3<f32>, n: vec3<f32>, f: LightFrame, e: Edge) -> f32 {
     let t = edge_term(p, f, e.v0.xyz, e.v1.xyz);
     let d0 = p - e.v0.xyz;
-    let d = d0 + n * (1e-4 * length(d0));
+    let d = d0 + n * (ON_PLANE * length(d0));
     return select(t, -t, dot(e.lit.xyz, d) > 0.0 && dot(e.unlit.xyz, d) <= 0.0);
 }

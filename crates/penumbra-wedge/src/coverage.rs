@@ -158,7 +158,7 @@ pub fn oriented_edge_term(p: Vec3, n: Vec3, [v0, v1]: [Vec3; 2], [lit, unlit]: [
 
 /// How far along its normal, relative to its distance from the edge, [`oriented_edge_term`]
 /// moves a receiver before its side tests: G-buffer positions round by about 1e-6 of their
-/// distance.
+/// distance. `coverage.wgsl` has the same constant (a test checks).
 pub const ON_PLANE: f32 = 1e-4;
 
 /// The visible fraction of the light's disk (in the projected plane the wedges use) when a
@@ -415,6 +415,12 @@ mod tests {
     }
 
     #[test]
+    fn shader_moves_receivers_off_planes_as_the_cpu_does() {
+        let wgsl = include_str!("../../../shaders/penumbra-wedge/coverage.wgsl");
+        assert!(wgsl.contains(&format!("const ON_PLANE: f32 = {ON_PLANE:e};")), "coverage.wgsl's ON_PLANE differs");
+    }
+
+    #[test]
     fn ground_hides_the_part_of_a_horizon_light_below_it_from_either_side() {
         // the ground square's silhouette from a light straddling its plane, seen from above and
         // below it, with the light's centre above and below the horizon
@@ -431,9 +437,8 @@ mod tests {
                 let p = Vec3::new(0.4, height, -0.3);
                 let LightShape::Distant { direction, .. } = light else { unreachable!() };
                 // the centre ray crosses the square
-                let t = -p.y / direction.y;
-                let h = p + direction * t;
-                let hard = t > 0.0 && h.x.abs() <= half && h.z.abs() <= half;
+                let hard =
+                    ray_hits_polygon(p, direction, &[q.positions[0], q.positions[1], q.positions[3], q.positions[2]]);
                 let wedge = visibility(p, Vec3::ZERO, &sil.edges, &sil.normals, u32::from(hard), &light);
                 let exact = ground_visible_fraction(p, half, &light);
                 partial += usize::from(exact > 0.05 && exact < 0.95);
