@@ -1,7 +1,8 @@
 // requires: gpu/brdf.wgsl gpu/sh9.wgsl gpu/fullscreen.wgsl
 // Shading pass: per pixel, the G-buffer surface lit by distant cone lights (the diffuse lobe by
 // the cone's exact irradiance, a GGX lobe by its representative point) and point lights, each
-// times its visibility layer, plus SH9 ambient on the diffuse lobe, as `ref-tracer`'s `lights`
+// times its visibility layer, plus ambient: SH9 irradiance on the diffuse lobe and the
+// prefiltered ambient map on the specular lobe (both signed), as `ref-tracer`'s `lights`
 // integrator; misses see the map.
 
 struct Light {
@@ -20,6 +21,9 @@ struct Params {
     corner: vec4<f32>,
     // x light count, y 1 = ambient on, z background width, w background height (0: black)
     counts: vec4<u32>,
+    // the prefiltered ambient of the specular lobe: x width, y height, z levels (0: none),
+    // w side of the directional-albedo table
+    ambient_info: vec4<u32>,
     // SH9 irradiance coefficients premultiplied by A_l
     sh: array<vec4<f32>, 9>,
 }
@@ -32,6 +36,10 @@ struct Params {
 @group(0) @binding(5) var g_geometric_normal: texture_2d<f32>;
 @group(0) @binding(6) var visibility: texture_2d_array<f32>;
 @group(0) @binding(7) var background: texture_2d<f32>;
+// `gpu::ambient`: the ambient map prefiltered per roughness level, and the GGX lobe's
+// directional albedo as (F0 scale, bias) over (cos theta_o, roughness)
+@group(0) @binding(8) var prefiltered: texture_2d_array<f32>;
+@group(0) @binding(9) var dfg: texture_2d<f32>;
 
 // Bilinear lat-long lookup, wrapping in u and clamping in v (`EnvMap::lookup`).
 fn background_radiance(dir: vec3<f32>) -> vec3<f32> {
@@ -62,6 +70,65 @@ fn background_radiance(dir: vec3<f32>) -> vec3<f32> {
     let top = mix(textureLoad(background, vec2<i32>(xi0, yi0), 0).rgb, textureLoad(background, vec2<i32>(xi1, yi0), 0).rgb, fx);
     let bottom = mix(textureLoad(background, vec2<i32>(xi0, yi1), 0).rgb, textureLoad(background, vec2<i32>(xi1, yi1), 0).rgb, fx);
     return mix(top, bottom, fy);
+}
+
+// Bilinear lat-long lookup in one prefiltered level, as `EnvMap::lookup`.
+fn prefiltered_level(dir: vec3<f32>, level: i32) -> vec3<f32> {
+    let w = params.ambient_info.x;
+    let h = params.ambient_info.y;
+    var u = atan2(dir.x, -dir.z) / (2.0 * PI);
+    if u < 0.0 {
+        u += 1.0;
+    }
+    let v = clamp(atan2(length(dir.xz), dir.y) / PI, 0.0, 1.0);
+    let x = u * f32(w) - 0.5;
+    let y = clamp(v * f32(h) - 0.5, 0.0, f32(h - 1u));
+    let x0 = floor(x);
+    let y0 = floor(y);
+    let fx = x - x0;
+    let fy = y - y0;
+    let wi = i32(w);
+    let xi0 = ((i32(x0) % wi) + wi) % wi;
+    let xi1 = (xi0 + 1) % wi;
+    let yi0 = i32(y0);
+    let yi1 = min(yi0 + 1, i32(h) - 1);
+    let top = mix(textureLoad(prefiltered, vec2<i32>(xi0, yi0), level, 0).rgb, textureLoad(prefiltered, vec2<i32>(xi1, yi0), level, 0).rgb, fx);
+    let bottom = mix(textureLoad(prefiltered, vec2<i32>(xi0, yi1), level, 0).rgb, textureLoad(prefiltered, vec2<i32>(xi1, yi1), level, 0).rgb, fx);
+    return mix(top, bottom, fy);
+}
+
+// The ambient map on a GGX lobe by the split-sum approximation (`gpu::ambient`): the map
+// prefiltered for the lobe's roughness along the mirror direction, times the lobe's directional
+// albedo F0 x scale + bias. Signed maps stay signed.
+fn specular_ambient(m: Material, n: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
+    let cos_o = dot(n, wo);
+    if params.ambient_info.z == 0u || m.albedo.a < 0.5 || cos_o <= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let roughness = clamp(m.f0_roughness.a, 0.0, 1.0);
+    let x = roughness * f32(params.ambient_info.z - 1u);
+    let k0 = i32(floor(x));
+    let k1 = min(k0 + 1, i32(params.ambient_info.z) - 1);
+    // a rough lobe's mass leans from the mirror direction towards the normal (Frostbite's
+    // dominant direction, Lagarde and de Rousiers 2014)
+    let alpha = roughness * roughness;
+    let smooth_ = 1.0 - alpha;
+    let r = normalize(mix(n, reflect(-wo, n), smooth_ * (sqrt(smooth_) + alpha)));
+    let radiance = mix(prefiltered_level(r, k0), prefiltered_level(r, k1), x - f32(k0));
+    // bilinear in the table, clamped at its edges (`DfgTable::lookup`)
+    let t = f32(params.ambient_info.w);
+    let tx = clamp(cos_o * t - 0.5, 0.0, t - 1.0);
+    let ty = clamp(roughness * t - 0.5, 0.0, t - 1.0);
+    let x0 = i32(floor(tx));
+    let y0 = i32(floor(ty));
+    let x1 = min(x0 + 1, i32(params.ambient_info.w) - 1);
+    let y1 = min(y0 + 1, i32(params.ambient_info.w) - 1);
+    let fx = tx - f32(x0);
+    let fy = ty - f32(y0);
+    let top = mix(textureLoad(dfg, vec2<i32>(x0, y0), 0).rg, textureLoad(dfg, vec2<i32>(x1, y0), 0).rg, fx);
+    let bottom = mix(textureLoad(dfg, vec2<i32>(x0, y1), 0).rg, textureLoad(dfg, vec2<i32>(x1, y1), 0).rg, fx);
+    let sb = mix(top, bottom, fy);
+    return radiance * (m.f0_roughness.rgb * sb.x + vec3<f32>(sb.y));
 }
 
 // Integral of cos over the part of a cone (half-angle with sin^2 = `sin2`) above the surface,
@@ -165,7 +232,9 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
         l += eval_brdf(m, n, wo, wi) * max(dot(n, wi), 0.0) * e * v;
     }
     if params.counts.y == 1u {
-        l += m.albedo.rgb * diffuse_weight(m) * max(sh9_irradiance(params.sh, n), vec3<f32>(0.0)) / PI;
+        // unclamped, as `ref-tracer`: a residual's irradiance is signed
+        l += m.albedo.rgb * diffuse_weight(m) * sh9_irradiance(params.sh, n) / PI;
     }
+    l += specular_ambient(m, n, wo);
     return vec4<f32>(l, 1.0);
 }

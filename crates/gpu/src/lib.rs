@@ -12,6 +12,7 @@
 //! ```
 
 pub mod accumulate;
+pub mod ambient;
 mod context;
 pub mod fullscreen;
 mod gbuffer;
@@ -23,6 +24,7 @@ mod target;
 mod technique;
 mod timer;
 
+pub use ambient::{DfgTable, PrefilterSettings, PrefilteredMap, SpecularAmbient};
 pub use context::{ADAPTER_ENV, Gpu, GpuError, adapters, describe_adapter, pick_adapter};
 pub use gbuffer::{
     GBUFFER_FORMAT, GBuffer, GBufferPass, view_projection, view_projection_infinite, view_projection_reverse,

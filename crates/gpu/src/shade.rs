@@ -1,6 +1,7 @@
 //! The shading pass and the visibility layers it reads: one R8Unorm layer per light, written by
 //! a shadow technique (or left at 1 for unshadowed light).
 
+use crate::ambient::{DfgTable, PrefilteredMap, SpecularAmbient};
 use crate::context::{Gpu, GpuError};
 use crate::gbuffer::GBuffer;
 use crate::geometry::SceneGeometry;
@@ -59,6 +60,9 @@ pub struct ShadeParams<'a> {
     pub ambient: Option<&'a Sh9>,
     /// What misses see; black without.
     pub background: Option<&'a Background>,
+    /// The ambient map prefiltered for the specular lobe (split sum); without it only the
+    /// lights reach the specular lobe.
+    pub specular_ambient: Option<&'a SpecularAmbient>,
 }
 
 /// One visibility layer per light, screen-sized, 1 = lit.
@@ -134,6 +138,7 @@ struct ShadeUniform {
     down: [f32; 4],
     corner: [f32; 4],
     counts: [u32; 4],
+    ambient_info: [u32; 4],
     sh: [[f32; 4]; 9],
 }
 
@@ -142,6 +147,8 @@ pub struct ShadingPass {
     pipeline: wgpu::RenderPipeline,
     // bound when a frame has no background (the shader then returns black)
     no_background: Background,
+    // bound when a frame has no specular ambient (the shader then skips it)
+    no_specular: SpecularAmbient,
 }
 
 /// Output format of the shading pass: linear HDR radiance.
@@ -155,7 +162,9 @@ impl ShadingPass {
     pub fn new(gpu: &Gpu) -> Result<Self, GpuError> {
         let module = crate::shader::module(&gpu.device, "shade", include_str!("../../../shaders/gpu/shade.wgsl"), &[]);
         let pipeline = crate::fullscreen::pipeline(gpu, "shade", &module, HDR_FORMAT);
-        Ok(Self { pipeline, no_background: Background::from_texels(gpu, (1, 1), &[[0.0; 4]])? })
+        let none = PrefilteredMap { levels: vec![EnvMap::constant(1, 1, Vec3::ZERO)] };
+        let no_specular = SpecularAmbient::upload(gpu, &none, &DfgTable { size: 1, values: vec![[0.0; 2]] })?;
+        Ok(Self { pipeline, no_background: Background::from_texels(gpu, (1, 1), &[[0.0; 4]])?, no_specular })
     }
 
     /// Shades `gbuffer` and returns the linear HDR image, row-major from the top-left.
@@ -191,6 +200,7 @@ impl ShadingPass {
             down: rays.down.extend(0.0).to_array(),
             corner: rays.corner.extend(0.0).to_array(),
             counts: [params.lights.len() as u32, u32::from(params.ambient.is_some()), bw, bh],
+            ambient_info: params.specular_ambient.map_or([0; 4], |s| [s.size.0, s.size.1, s.size.2, s.table_size]),
             sh,
         };
         let mut lights: Vec<LightUniform> = params
@@ -222,10 +232,12 @@ impl ShadingPass {
         });
         let views = [&gbuffer.position, &gbuffer.normal, &gbuffer.geometric_normal, background]
             .map(|t| t.create_view(&Default::default()));
-        let vis_view = visibility.texture.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            ..Default::default()
-        });
+        let array =
+            wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() };
+        let vis_view = visibility.texture.create_view(&array);
+        let specular = params.specular_ambient.unwrap_or(&self.no_specular);
+        let levels_view = specular.levels.create_view(&array);
+        let table_view = specular.table.create_view(&Default::default());
         let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("shade"),
             layout: &self.pipeline.get_bind_group_layout(0),
@@ -238,6 +250,8 @@ impl ShadingPass {
                 wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&views[2]) },
                 wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::TextureView(&vis_view) },
                 wgpu::BindGroupEntry { binding: 7, resource: wgpu::BindingResource::TextureView(&views[3]) },
+                wgpu::BindGroupEntry { binding: 8, resource: wgpu::BindingResource::TextureView(&levels_view) },
+                wgpu::BindGroupEntry { binding: 9, resource: wgpu::BindingResource::TextureView(&table_view) },
             ],
         });
         let out_view = output.create_view(&Default::default());

@@ -87,7 +87,12 @@ fn shading_matches_ref_tracer_lights_without_shadows() {
     let (image, positions) = gpu_render(
         &gpu,
         &scene,
-        &ShadeParams { lights: &shade_lights, ambient: Some(&ambient), background: Some(&background) },
+        &ShadeParams {
+            lights: &shade_lights,
+            ambient: Some(&ambient),
+            background: Some(&background),
+            ..Default::default()
+        },
     );
     let bvh = SceneBvh::new(&scene);
     let set = LightSet {

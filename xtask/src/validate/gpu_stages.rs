@@ -117,7 +117,12 @@ pub(super) fn gpu_render(
     let (w, h) = gb.size();
     let pass = &passes.shading;
     let background = Background::upload(gpu, map).map_err(e)?;
-    let params = ShadeParams { lights: &lights, ambient: Some(&d.ambient_sh), background: Some(&background) };
+    let params = ShadeParams {
+        lights: &lights,
+        ambient: Some(&d.ambient_sh),
+        background: Some(&background),
+        ..Default::default()
+    };
     let common = start.elapsed().as_secs_f64();
     let mut out = Vec::new();
     let mut all = techniques(gpu, scene, plan)?;
