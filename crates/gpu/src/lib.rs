@@ -20,9 +20,11 @@ mod geometry;
 mod readback;
 mod shade;
 pub mod shader;
+mod split;
 mod target;
 mod technique;
 mod timer;
+mod upsample;
 
 pub use ambient::{DfgTable, PrefilterSettings, PrefilteredMap, SpecularAmbient};
 pub use context::{ADAPTER_ENV, Gpu, GpuError, adapters, describe_adapter, pick_adapter};
@@ -31,10 +33,12 @@ pub use gbuffer::{
 };
 pub use geometry::{Chunk, SceneGeometry, ShadowGeometry, scene_triangles};
 pub use readback::{read_texture_f32, read_texture_rgba};
-pub use shade::{Background, HDR_FORMAT, ShadeLight, ShadeParams, ShadingPass, Visibility, downsample_box};
+pub use shade::{Background, HDR_FORMAT, ShadeLight, ShadeParams, ShadingPass, Visibility, downsample_box, read_hdr};
+pub use split::{SplitFrame, SplitImage, SplitPasses, SplitSettings, render_split};
 pub use target::{layer_view, render_target};
 pub use technique::{
     LightShape, PrecomputedVisibility, Receivers, ShadowPassReport, ShadowTechnique, WEBER_FRACTION,
     WEBER_MAX_RECEIVERS, render_visibility, totals, weber_negligible,
 };
 pub use timer::Clock;
+pub use upsample::{JointBilateral, UpsamplePass};

@@ -170,8 +170,7 @@ impl ShadingPass {
     /// Shades `gbuffer` and returns the linear HDR image, row-major from the top-left.
     ///
     /// # Errors
-    /// [`GpuError::TooLarge`] when `visibility` has fewer layers than lights or the map is too
-    /// large; GPU failures.
+    /// As [`ShadingPass::render_texture`].
     pub fn render(
         &self,
         gpu: &Gpu,
@@ -180,6 +179,23 @@ impl ShadingPass {
         params: &ShadeParams,
         visibility: &Visibility,
     ) -> Result<Vec<Vec3>, GpuError> {
+        let output = self.render_texture(gpu, geometry, gbuffer, params, visibility)?;
+        read_hdr(gpu, &output)
+    }
+
+    /// Shades `gbuffer` into a new [`HDR_FORMAT`] texture of its size, left on the GPU.
+    ///
+    /// # Errors
+    /// [`GpuError::TooLarge`] when `visibility` has fewer layers than lights or the map is too
+    /// large; GPU failures.
+    pub fn render_texture(
+        &self,
+        gpu: &Gpu,
+        geometry: &SceneGeometry,
+        gbuffer: &GBuffer,
+        params: &ShadeParams,
+        visibility: &Visibility,
+    ) -> Result<wgpu::Texture, GpuError> {
         let (w, h) = gbuffer.size();
         if (params.lights.len() as u32) > visibility.layers() {
             return Err(GpuError::TooLarge {
@@ -256,9 +272,17 @@ impl ShadingPass {
         });
         let out_view = output.create_view(&Default::default());
         crate::fullscreen::draw(gpu, &self.pipeline, &bind, &out_view, wgpu::Color::BLACK)?;
-        let rgba = crate::readback::read_texture_rgba(gpu, &output, 0)?;
-        Ok(rgba.into_iter().map(|v| Vec3::new(v[0], v[1], v[2])).collect())
+        Ok(output)
     }
+}
+
+/// Reads an [`HDR_FORMAT`] image back as RGB, row-major from the top-left.
+///
+/// # Errors
+/// GPU failures.
+pub fn read_hdr(gpu: &Gpu, texture: &wgpu::Texture) -> Result<Vec<Vec3>, GpuError> {
+    let rgba = crate::readback::read_texture_rgba(gpu, texture, 0)?;
+    Ok(rgba.into_iter().map(|v| Vec3::new(v[0], v[1], v[2])).collect())
 }
 
 /// An environment map on the GPU, as what camera rays that miss see: uploaded once, shaded

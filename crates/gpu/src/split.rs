@@ -1,0 +1,144 @@
+//! Paper 001's frame (sections 3.4-3.5): the EnvDirects (the first lights, high-frequency) shaded
+//! at full resolution with the ambient, the EnvIndirects (the rest, low-frequency) shaded from a
+//! G-buffer at 1 / `indirect_scale` of the resolution with their own shadow technique, and
+//! joint-bilateral upsampled onto the first. What a light *is* (direct or indirect) comes from
+//! the extraction; this module only draws it.
+
+use crate::ambient::SpecularAmbient;
+use crate::context::{Gpu, GpuError};
+use crate::gbuffer::GBufferPass;
+use crate::geometry::SceneGeometry;
+use crate::shade::{Background, ShadeLight, ShadeParams, ShadingPass, Visibility};
+use crate::technique::{
+    LightShape, Receivers, ShadowPassReport, ShadowTechnique, WEBER_FRACTION, render_visibility, weber_negligible,
+};
+use crate::upsample::{JointBilateral, UpsamplePass};
+use envmap_sphere::Sh9;
+
+/// How the EnvIndirects are drawn.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SplitSettings {
+    /// The EnvIndirects are shaded at 1 / this of the G-buffer's resolution (1: full; the
+    /// G-buffer's sides must be multiples of it).
+    pub indirect_scale: u32,
+    /// How they are brought back to full resolution.
+    pub upsample: JointBilateral,
+}
+
+impl Default for SplitSettings {
+    /// Paper 001: half resolution, its joint bilateral sigmas.
+    fn default() -> Self {
+        Self { indirect_scale: 2, upsample: JointBilateral::PAPER }
+    }
+}
+
+/// The lights and ambient of one frame.
+#[derive(Clone, Copy)]
+pub struct SplitFrame<'a> {
+    /// Every light, the EnvDirects first.
+    pub lights: &'a [ShadeLight],
+    /// Their shapes, for shadow techniques, in the same order.
+    pub shapes: &'a [LightShape],
+    /// How many of `lights` are EnvDirects.
+    pub directs: usize,
+    /// Ambient SH9 (diffuse lobe), may be signed.
+    pub ambient: Option<&'a Sh9>,
+    /// The ambient on the specular lobe.
+    pub specular_ambient: Option<&'a SpecularAmbient>,
+    /// What misses see.
+    pub background: Option<&'a Background>,
+}
+
+/// The passes a split frame uses, built once.
+pub struct SplitPasses<'a> {
+    /// For the low-resolution G-buffer.
+    pub gbuffer: &'a GBufferPass,
+    /// Shading at both resolutions.
+    pub shading: &'a ShadingPass,
+    /// Joint bilateral upsampling (and, at scale 1, the sum of the two parts).
+    pub upsample: &'a UpsamplePass,
+}
+
+/// A split frame's image and what its EnvIndirects cost.
+pub struct SplitImage {
+    /// Full-resolution HDR image.
+    pub texture: wgpu::Texture,
+    /// The EnvIndirects' shadow passes, one report per indirect light.
+    pub indirect_reports: Vec<ShadowPassReport>,
+    /// The resolution the EnvIndirects were shaded at.
+    pub indirect_size: (u32, u32),
+}
+
+/// Renders a split frame over `receivers` (the full-resolution G-buffer and its points). The
+/// EnvDirects' visibility comes in `direct_visibility` (layer k for light k < `directs`, made
+/// by the caller with any technique); the EnvIndirects' is made here with `indirect` at the
+/// reduced resolution, skipping lights no receiver faces and those Weber's law finds
+/// negligible there.
+///
+/// # Errors
+/// [`GpuError::Failed`] for a scale that does not divide the G-buffer's size or more directs
+/// than lights; GPU failures.
+pub fn render_split(
+    gpu: &Gpu,
+    passes: &SplitPasses,
+    geometry: &SceneGeometry,
+    (receivers, direct_visibility): (&Receivers, &Visibility),
+    frame: &SplitFrame,
+    indirect: &dyn ShadowTechnique,
+    settings: &SplitSettings,
+) -> Result<SplitImage, GpuError> {
+    let gb = receivers.gbuffer;
+    let (w, h) = gb.size();
+    let f = settings.indirect_scale;
+    if f == 0 || w % f != 0 || h % f != 0 {
+        return Err(GpuError::Failed(format!("EnvIndirects at 1/{f} of {w}x{h}: the scale must divide both sides")));
+    }
+    if frame.directs > frame.lights.len() || frame.shapes.len() != frame.lights.len() {
+        return Err(GpuError::Failed(format!(
+            "{} directs of {} lights ({} shapes)",
+            frame.directs,
+            frame.lights.len(),
+            frame.shapes.len()
+        )));
+    }
+    let (directs, indirects) = frame.lights.split_at(frame.directs);
+    let indirect_shapes = &frame.shapes[frame.directs..];
+    let base = passes.shading.render_texture(
+        gpu,
+        geometry,
+        gb,
+        &ShadeParams {
+            lights: directs,
+            ambient: frame.ambient,
+            background: frame.background,
+            specular_ambient: frame.specular_ambient,
+        },
+        direct_visibility,
+    )?;
+    let low_camera = scene::Camera { width: w / f, height: h / f, ..gb.camera };
+    let (low_gb, low_points, low_receivers);
+    let low = if f == 1 {
+        receivers
+    } else {
+        low_gb = passes.gbuffer.render(gpu, geometry, &low_camera)?;
+        low_points = low_gb.read_points(gpu)?;
+        low_receivers = Receivers::new(&low_gb, &low_points);
+        &low_receivers
+    };
+    let (lw, lh) = low.gbuffer.size();
+    let visibility = Visibility::new(gpu, lw, lh, indirects.len() as u32)?;
+    // the directs count towards what a receiver already gets
+    let negligible = weber_negligible(low, frame.lights, frame.ambient, WEBER_FRACTION).split_off(frame.directs);
+    let indirect_reports = render_visibility(gpu, indirect, low, indirect_shapes, &negligible, &visibility)?;
+    let shaded = passes.shading.render_texture(
+        gpu,
+        geometry,
+        low.gbuffer,
+        &ShadeParams { lights: indirects, ..Default::default() },
+        &visibility,
+    )?;
+    // at scale 1 the pass with a 1 x 1 window is the plain sum
+    let upsample = if f == 1 { JointBilateral { radius: 0, ..JointBilateral::GAUSSIAN } } else { settings.upsample };
+    let texture = passes.upsample.render(gpu, geometry, (low.gbuffer, &shaded), (gb, &base), &upsample)?;
+    Ok(SplitImage { texture, indirect_reports, indirect_size: (lw, lh) })
+}
