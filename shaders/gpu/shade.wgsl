@@ -35,66 +35,42 @@ struct Params {
 @group(0) @binding(4) var g_normal: texture_2d<f32>;
 @group(0) @binding(5) var g_geometric_normal: texture_2d<f32>;
 @group(0) @binding(6) var visibility: texture_2d_array<f32>;
-@group(0) @binding(7) var background: texture_2d<f32>;
+@group(0) @binding(7) var background: texture_2d_array<f32>;
 // `gpu::ambient`: the ambient map prefiltered per roughness level, and the GGX lobe's
 // directional albedo as (F0 scale, bias) over (cos theta_o, roughness)
 @group(0) @binding(8) var prefiltered: texture_2d_array<f32>;
 @group(0) @binding(9) var dfg: texture_2d<f32>;
 
-// Bilinear lat-long lookup, wrapping in u and clamping in v (`EnvMap::lookup`).
-fn background_radiance(dir: vec3<f32>) -> vec3<f32> {
-    let w = params.counts.z;
-    let h = params.counts.w;
-    if w == 0u || h == 0u {
-        return vec3<f32>(0.0);
-    }
+// Bilinear lat-long lookup in layer `layer` of `t` (`size` texels), wrapping in u and
+// clamping in v (`EnvMap::lookup`).
+fn latlong_bilinear(t: texture_2d_array<f32>, layer: i32, size: vec2<u32>, dir: vec3<f32>) -> vec3<f32> {
     var u = atan2(dir.x, -dir.z) / (2.0 * PI);
     if u < 0.0 {
         u += 1.0;
     }
-    if u >= 1.0 {
-        u = 0.0;
-    }
     let v = clamp(atan2(length(dir.xz), dir.y) / PI, 0.0, 1.0);
-    let x = u * f32(w) - 0.5;
-    let y = clamp(v * f32(h) - 0.5, 0.0, f32(h - 1u));
+    let x = u * f32(size.x) - 0.5;
+    let y = clamp(v * f32(size.y) - 0.5, 0.0, f32(size.y - 1u));
     let x0 = floor(x);
     let y0 = floor(y);
     let fx = x - x0;
     let fy = y - y0;
-    let wi = i32(w);
+    let wi = i32(size.x);
     let xi0 = ((i32(x0) % wi) + wi) % wi;
     let xi1 = (xi0 + 1) % wi;
     let yi0 = i32(y0);
-    let yi1 = min(yi0 + 1, i32(h) - 1);
-    let top = mix(textureLoad(background, vec2<i32>(xi0, yi0), 0).rgb, textureLoad(background, vec2<i32>(xi1, yi0), 0).rgb, fx);
-    let bottom = mix(textureLoad(background, vec2<i32>(xi0, yi1), 0).rgb, textureLoad(background, vec2<i32>(xi1, yi1), 0).rgb, fx);
+    let yi1 = min(yi0 + 1, i32(size.y) - 1);
+    let top = mix(textureLoad(t, vec2<i32>(xi0, yi0), layer, 0).rgb, textureLoad(t, vec2<i32>(xi1, yi0), layer, 0).rgb, fx);
+    let bottom = mix(textureLoad(t, vec2<i32>(xi0, yi1), layer, 0).rgb, textureLoad(t, vec2<i32>(xi1, yi1), layer, 0).rgb, fx);
     return mix(top, bottom, fy);
 }
 
-// Bilinear lat-long lookup in one prefiltered level, as `EnvMap::lookup`.
-fn prefiltered_level(dir: vec3<f32>, level: i32) -> vec3<f32> {
-    let w = params.ambient_info.x;
-    let h = params.ambient_info.y;
-    var u = atan2(dir.x, -dir.z) / (2.0 * PI);
-    if u < 0.0 {
-        u += 1.0;
+// What a camera ray that misses sees: the map, or black without one.
+fn background_radiance(dir: vec3<f32>) -> vec3<f32> {
+    if params.counts.z == 0u || params.counts.w == 0u {
+        return vec3<f32>(0.0);
     }
-    let v = clamp(atan2(length(dir.xz), dir.y) / PI, 0.0, 1.0);
-    let x = u * f32(w) - 0.5;
-    let y = clamp(v * f32(h) - 0.5, 0.0, f32(h - 1u));
-    let x0 = floor(x);
-    let y0 = floor(y);
-    let fx = x - x0;
-    let fy = y - y0;
-    let wi = i32(w);
-    let xi0 = ((i32(x0) % wi) + wi) % wi;
-    let xi1 = (xi0 + 1) % wi;
-    let yi0 = i32(y0);
-    let yi1 = min(yi0 + 1, i32(h) - 1);
-    let top = mix(textureLoad(prefiltered, vec2<i32>(xi0, yi0), level, 0).rgb, textureLoad(prefiltered, vec2<i32>(xi1, yi0), level, 0).rgb, fx);
-    let bottom = mix(textureLoad(prefiltered, vec2<i32>(xi0, yi1), level, 0).rgb, textureLoad(prefiltered, vec2<i32>(xi1, yi1), level, 0).rgb, fx);
-    return mix(top, bottom, fy);
+    return latlong_bilinear(background, 0, params.counts.zw, dir);
 }
 
 // The ambient map on a GGX lobe by the split-sum approximation (`gpu::ambient`): the map
@@ -114,7 +90,8 @@ fn specular_ambient(m: Material, n: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
     let alpha = roughness * roughness;
     let smooth_ = 1.0 - alpha;
     let r = normalize(mix(n, reflect(-wo, n), smooth_ * (sqrt(smooth_) + alpha)));
-    let radiance = mix(prefiltered_level(r, k0), prefiltered_level(r, k1), x - f32(k0));
+    let size = params.ambient_info.xy;
+    let radiance = mix(latlong_bilinear(prefiltered, k0, size, r), latlong_bilinear(prefiltered, k1, size, r), x - f32(k0));
     // bilinear in the table, clamped at its edges (`DfgTable::lookup`)
     let t = f32(params.ambient_info.w);
     let tx = clamp(cos_o * t - 0.5, 0.0, t - 1.0);

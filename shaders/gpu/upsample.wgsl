@@ -57,23 +57,9 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let centre = vec2<i32>(round(c));
     let r = i32(params.info.y);
     let size = vec2<i32>(i32(params.info.z), i32(params.info.w));
+    // weights relative to the best sample so far (an online maximum, as in a streaming
+    // softmax): the sums are rescaled when a better one comes
     var best = 3.4e38;
-    for (var y = -r; y <= r; y++) {
-        for (var x = -r; x <= r; x++) {
-            let q = centre + vec2<i32>(x, y);
-            if any(q < vec2<i32>(0)) || any(q >= size) {
-                continue;
-            }
-            let e = exponent(q, c, hp.xyz, n, a, d);
-            if e >= 0.0 {
-                best = min(best, e);
-            }
-        }
-    }
-    if best > 3.0e38 {
-        // no surface in the window: nothing to add
-        return b;
-    }
     var sum = vec3<f32>(0.0);
     var weight = 0.0;
     for (var y = -r; y <= r; y++) {
@@ -83,12 +69,25 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
                 continue;
             }
             let e = exponent(q, c, hp.xyz, n, a, d);
-            if e >= 0.0 {
-                let w = exp(best - e);
-                sum += w * textureLoad(low_image, q, 0).rgb;
-                weight += w;
+            if e < 0.0 {
+                continue;
             }
+            var w = 1.0;
+            if e < best {
+                let rescale = select(exp(e - best), 0.0, best > 3.0e38);
+                sum *= rescale;
+                weight *= rescale;
+                best = e;
+            } else {
+                w = exp(best - e);
+            }
+            sum += w * textureLoad(low_image, q, 0).rgb;
+            weight += w;
         }
+    }
+    if weight <= 0.0 {
+        // no surface in the window: nothing to add
+        return b;
     }
     return vec4<f32>(b.rgb + sum / weight, b.a);
 }

@@ -246,13 +246,14 @@ impl ShadingPass {
             contents: bytemuck::cast_slice(&lights),
             usage: wgpu::BufferUsages::STORAGE,
         });
-        let views = [&gbuffer.position, &gbuffer.normal, &gbuffer.geometric_normal, background]
+        let views = [&gbuffer.position, &gbuffer.normal, &gbuffer.geometric_normal]
             .map(|t| t.create_view(&Default::default()));
         let array =
             wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() };
         let vis_view = visibility.texture.create_view(&array);
         let specular = params.specular_ambient.unwrap_or(&self.no_specular);
         let levels_view = specular.levels.create_view(&array);
+        let background_view = background.create_view(&array);
         let table_view = specular.table.create_view(&Default::default());
         let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("shade"),
@@ -265,7 +266,7 @@ impl ShadingPass {
                 wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&views[1]) },
                 wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&views[2]) },
                 wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::TextureView(&vis_view) },
-                wgpu::BindGroupEntry { binding: 7, resource: wgpu::BindingResource::TextureView(&views[3]) },
+                wgpu::BindGroupEntry { binding: 7, resource: wgpu::BindingResource::TextureView(&background_view) },
                 wgpu::BindGroupEntry { binding: 8, resource: wgpu::BindingResource::TextureView(&levels_view) },
                 wgpu::BindGroupEntry { binding: 9, resource: wgpu::BindingResource::TextureView(&table_view) },
             ],
