@@ -84,7 +84,7 @@ pub struct LightsData {
 /// their `direction`, `solid_angle` and `radiance` are read) and, when an `ambient.exr` sits
 /// beside it, that map and its SH9.
 pub fn load_lights(path: &Path) -> Result<LightsData, String> {
-    let LightsFile { lights, interleaved } = read_lights_json(path).map_err(|e| e.to_string())?;
+    let LightsFile { lights, interleaved, .. } = read_lights_json(path).map_err(|e| e.to_string())?;
     let ambient_path = path.with_file_name("ambient.exr");
     // signed when it is a residual (`+residual`): negative values are data, not ringing
     let signed = LoadOptions { negative: NegativePolicy::Keep, ..LoadOptions::default() };

@@ -421,6 +421,7 @@ impl LightExtractor for CenterSurround {
                     radiance: (power / solid_angle).as_vec3(),
                 },
                 extent: ri as f32,
+                indirect: false,
             });
         }
         // The books: the remainder plus the lights is the map with negatives clamped (loaded maps

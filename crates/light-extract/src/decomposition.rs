@@ -16,6 +16,9 @@ pub struct ExtractedLight {
     pub light: DistantLight,
     /// Angular radius of the cluster of texels the light replaces, radians.
     pub extent: f32,
+    /// One of paper 001's EnvIndirects (a low-frequency cluster of non-emissive texels), which
+    /// a renderer may shade at reduced resolution; `false` for every other light.
+    pub indirect: bool,
 }
 
 impl ExtractedLight {
@@ -142,7 +145,7 @@ pub fn interleaved_sets(lights: &[ExtractedLight], sets: usize, jitter: f32, see
                     let phi = rng.random::<f32>() * std::f32::consts::TAU;
                     let f = Frame::new(l.light.direction);
                     let d = f.to_world(Vec3::new(sin * phi.cos(), sin * phi.sin(), cos)).normalize();
-                    ExtractedLight { light: DistantLight { direction: d, ..l.light }, extent: l.extent }
+                    ExtractedLight { light: DistantLight { direction: d, ..l.light }, ..*l }
                 })
                 .collect()
         })

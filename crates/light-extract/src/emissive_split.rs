@@ -137,6 +137,7 @@ impl Cluster {
                 radiance: (self.power / solid_angle).as_vec3(),
             },
             extent: extent as f32,
+            indirect: false,
         })
     }
 }
@@ -364,6 +365,9 @@ impl LightExtractor for EmissiveSplit {
             }
         }
         let n_directs = directs.len();
+        for l in &mut indirects {
+            l.indirect = true;
+        }
         let mut lights = directs;
         lights.extend(indirects);
         let params = serde_json::json!({

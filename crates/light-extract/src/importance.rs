@@ -72,6 +72,7 @@ impl LightExtractor for ImportanceSampled {
                 Some(ExtractedLight {
                     light: DistantLight { direction: s.dir, solid_angle: texel_sa, radiance: power / texel_sa },
                     extent: (1.0 - represented / std::f32::consts::TAU).clamp(-1.0, 1.0).acos(),
+                    indirect: false,
                 })
             })
             .collect();

@@ -9,7 +9,8 @@
 //!   "map_power": [r, g, b],          // integral of the map's radiance over the sphere
 //!   "ambient_power": [r, g, b],      // the same for the remainder (ambient.exr)
 //!   "lights": [ { "direction": [x, y, z], "solid_angle": sr, "half_angle": rad,
-//!                 "radiance": [r, g, b], "power": [r, g, b], "extent": rad }, ... ],
+//!                 "radiance": [r, g, b], "power": [r, g, b], "extent": rad,
+//!                 "indirect": bool }, ... ],  // one of paper 001's EnvIndirects
 //!   "interleaved": [ [ light, ... ], ... ] }   // the extra sets of interleaved sampling
 //! ```
 //!
@@ -73,6 +74,9 @@ pub struct LightsFile {
     pub lights: Vec<DistantLight>,
     /// `interleaved[][]` (may be empty).
     pub interleaved: Vec<Vec<DistantLight>>,
+    /// Per light of `lights`, whether it is one of paper 001's EnvIndirects (`indirect`; false
+    /// when absent).
+    pub indirect: Vec<bool>,
 }
 
 #[derive(Deserialize)]
@@ -87,6 +91,8 @@ struct RawLight {
     direction: [f32; 3],
     solid_angle: f32,
     radiance: [f32; 3],
+    #[serde(default)]
+    indirect: bool,
 }
 
 fn check_lights(path: &Path, raw: &[RawLight], set: Option<usize>) -> Result<Vec<DistantLight>, LightsFileError> {
@@ -131,7 +137,7 @@ pub fn parse_lights_json(bytes: &[u8], path: &Path) -> Result<LightsFile, Lights
         .enumerate()
         .map(|(k, set)| check_lights(path, set, Some(k)))
         .collect::<Result<_, _>>()?;
-    Ok(LightsFile { lights, interleaved })
+    Ok(LightsFile { lights, interleaved, indirect: raw.lights.iter().map(|l| l.indirect).collect() })
 }
 
 /// [`parse_lights_json`] of the file at `path`.
@@ -152,6 +158,7 @@ fn light_json(l: &ExtractedLight) -> Value {
         "radiance": l.light.radiance.to_array(),
         "power": p.to_array(),
         "extent": l.extent,
+        "indirect": l.indirect,
     })
 }
 

@@ -81,6 +81,7 @@ pub(crate) fn region_light(map: &EnvMap, row_sa: &[f64], dirs: &TexelDirections,
             radiance: (power / solid_angle.max(1e-300)).as_vec3(),
         },
         extent,
+        indirect: false,
     }
 }
 

@@ -58,6 +58,7 @@ impl CompactSource {
                 radiance: (self.power / solid_angle).as_vec3(),
             },
             extent: self.extent,
+            indirect: false,
         }
     }
 

@@ -528,3 +528,26 @@ fn cones_crossing_the_horizon_are_narrowed_to_it() {
     assert!(l.solid_angle > 0.0 && l.radiance.is_finite(), "{l:?}");
     assert!((l.power() - Vec3::splat(0.01)).abs().max_element() < 1e-6);
 }
+
+#[test]
+fn env_indirects_are_flagged_through_wrappers_and_lights_json() {
+    let map = envmap_sphere::default_map();
+    for method in ["emissive-split", "emissive-split+moment-cones+above-horizon+residual"] {
+        let d = light_extract::extractor(method, 32).unwrap().extract(&map).unwrap_or_else(|e| panic!("{e}"));
+        // the innermost split's count: the first lights are the EnvDirects, the rest are flagged
+        let mut p = &d.params;
+        while p.get("env_directs").is_none() {
+            p = &p["inner"];
+        }
+        let n = p["env_directs"].as_u64().unwrap() as usize;
+        assert!(n > 0 && n < d.lights.len(), "{method}: {n} of {}", d.lights.len());
+        let flags: Vec<bool> = d.lights.iter().map(|l| l.indirect).collect();
+        assert!(flags[..n].iter().all(|f| !f) && flags[n..].iter().all(|f| *f), "{method}: {flags:?}");
+        let json = serde_json::to_vec(&d.to_json(&d.interleaved())).unwrap();
+        let file = light_extract::output::parse_lights_json(&json, std::path::Path::new("lights.json")).unwrap();
+        assert_eq!(file.indirect, flags, "{method}");
+        assert!(d.interleaved().iter().all(|set| set.iter().map(|l| l.indirect).eq(flags.iter().copied())));
+    }
+    let d = light_extract::extractor("median-cut", 16).unwrap().extract(&map).unwrap();
+    assert!(d.lights.iter().all(|l| !l.indirect), "median cut has no EnvIndirects");
+}
