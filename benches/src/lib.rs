@@ -2,6 +2,7 @@
 //! the knob it measures. `cargo bench -p envshadow-benches` runs it; `cargo xtask test` runs
 //! every bench once so none rots. This library holds the inputs benches share.
 
+pub mod decomposition;
 pub mod soft_shadows;
 
 use envmap_sphere::EnvMap;

@@ -57,6 +57,29 @@ pub fn draw(
     target: &wgpu::TextureView,
     clear: wgpu::Color,
 ) -> Result<(), GpuError> {
+    run(gpu, pipeline, bind, target, wgpu::LoadOp::Clear(clear))
+}
+
+/// As [`draw`] over what `target` holds: pixels the shader discards keep their value.
+///
+/// # Errors
+/// GPU failures.
+pub fn draw_over(
+    gpu: &Gpu,
+    pipeline: &wgpu::RenderPipeline,
+    bind: &wgpu::BindGroup,
+    target: &wgpu::TextureView,
+) -> Result<(), GpuError> {
+    run(gpu, pipeline, bind, target, wgpu::LoadOp::Load)
+}
+
+fn run(
+    gpu: &Gpu,
+    pipeline: &wgpu::RenderPipeline,
+    bind: &wgpu::BindGroup,
+    target: &wgpu::TextureView,
+    load: wgpu::LoadOp<wgpu::Color>,
+) -> Result<(), GpuError> {
     let mut encoder = gpu.encoder("full-screen pass");
     {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -65,7 +88,7 @@ pub fn draw(
                 view: target,
                 depth_slice: None,
                 resolve_target: None,
-                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(clear), store: wgpu::StoreOp::Store },
+                ops: wgpu::Operations { load, store: wgpu::StoreOp::Store },
             })],
             ..Default::default()
         });

@@ -17,6 +17,7 @@ mod context;
 pub mod fullscreen;
 mod gbuffer;
 mod geometry;
+mod interleave;
 mod readback;
 mod shade;
 pub mod shader;
@@ -32,6 +33,7 @@ pub use gbuffer::{
     GBUFFER_FORMAT, GBuffer, GBufferPass, view_projection, view_projection_infinite, view_projection_reverse,
 };
 pub use geometry::{Chunk, SceneGeometry, ShadowGeometry, scene_triangles};
+pub use interleave::{InterleavePass, interleave_set, interleave_tile};
 pub use readback::{read_texture_f32, read_texture_rgba};
 pub use shade::{Background, HDR_FORMAT, ShadeLight, ShadeParams, ShadingPass, Visibility, downsample_box, read_hdr};
 pub use split::{SplitFrame, SplitImage, SplitPasses, SplitSettings, render_split};

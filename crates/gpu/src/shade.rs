@@ -246,8 +246,8 @@ impl ShadingPass {
             contents: bytemuck::cast_slice(&lights),
             usage: wgpu::BufferUsages::STORAGE,
         });
-        let views = [&gbuffer.position, &gbuffer.normal, &gbuffer.geometric_normal]
-            .map(|t| t.create_view(&Default::default()));
+        let views =
+            [&gbuffer.position, &gbuffer.normal, &gbuffer.geometric_normal].map(|t| t.create_view(&Default::default()));
         let array =
             wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() };
         let vis_view = visibility.texture.create_view(&array);

@@ -90,7 +90,7 @@ pub fn render_split(
     let gb = receivers.gbuffer;
     let (w, h) = gb.size();
     let f = settings.indirect_scale;
-    if f == 0 || w % f != 0 || h % f != 0 {
+    if f == 0 || !w.is_multiple_of(f) || !h.is_multiple_of(f) {
         return Err(GpuError::Failed(format!("EnvIndirects at 1/{f} of {w}x{h}: the scale must divide both sides")));
     }
     if frame.directs > frame.lights.len() || frame.shapes.len() != frame.lights.len() {

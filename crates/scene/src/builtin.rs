@@ -4,7 +4,7 @@ use crate::{Camera, Ggx, Material, Mesh, Object, PointLight, Scene, SceneError};
 use glam::Vec3;
 
 /// Names of the built-in scenes.
-pub const BUILTIN_SCENES: [&str; 5] = ["spheres_box", "three_boxes", "column", "glossy_set", "room"];
+pub const BUILTIN_SCENES: [&str; 6] = ["spheres_box", "three_boxes", "column", "glossy_set", "room", "gallery"];
 
 /// Subdivision level of the `spheres_box` sphere: 20 x 4^5 = 20,480 triangles. Its largest
 /// deviation from the true sphere is 0.15 mm, under 0.02 pixel at 640 x 480 (a test checks).
@@ -35,6 +35,7 @@ impl Scene {
             "column" => column(),
             "glossy_set" => glossy_set(),
             "room" => room(),
+            "gallery" => gallery(),
             _ => return Err(SceneError::Unknown { name: name.into() }),
         };
         Ok(scene)
@@ -121,6 +122,51 @@ fn glossy_set() -> Scene {
             ),
         ],
         camera: camera(Vec3::new(0.0, 2.6, 7.5), Vec3::new(0.0, 0.6, 0.0), 45.0),
+        point_lights: vec![],
+    }
+}
+
+/// Paper 001's scale for timing (its Unity scene has 161.8k triangles): 161,794 triangles of
+/// diffuse to glossy, dielectric and metal objects on a diffuse ground. Six level-5 spheres
+/// (20,480 triangles each) from Lambertian to polished metal, two 4096-segment columns and two
+/// finely tessellated boxes.
+fn gallery() -> Scene {
+    let ggx = |roughness: f32, f0: Vec3| Some(Ggx { roughness, f0 });
+    let dielectric = Vec3::splat(0.04);
+    let gold = Vec3::new(1.0, 0.78, 0.34);
+    let silver = Vec3::new(0.97, 0.96, 0.91);
+    let spheres = [
+        ("diffuse_sphere", Material { albedo: Vec3::new(0.8, 0.35, 0.3), specular: None }),
+        ("rough_sphere", Material { albedo: Vec3::new(0.3, 0.7, 0.35), specular: ggx(0.7, dielectric) }),
+        ("semi_glossy_sphere", Material { albedo: Vec3::new(0.3, 0.4, 0.8), specular: ggx(0.35, dielectric) }),
+        ("glossy_sphere", Material { albedo: Vec3::splat(0.7), specular: ggx(0.15, dielectric) }),
+        ("rough_gold_sphere", Material { albedo: Vec3::ZERO, specular: ggx(0.5, gold) }),
+        ("polished_silver_sphere", Material { albedo: Vec3::ZERO, specular: ggx(0.2, silver) }),
+    ];
+    let mut objects = vec![object("ground", ground(20.0), Material::lambert(0.5))];
+    for (k, (name, material)) in spheres.into_iter().enumerate() {
+        let (x, z) = (-3.75 + 1.5 * k as f32, if k % 2 == 0 { 0.6 } else { -0.6 });
+        objects.push(object(name, Mesh::icosphere(Vec3::new(x, 0.6, z), 0.6, 5), material));
+    }
+    for (k, x) in [-4.3f32, 4.3].into_iter().enumerate() {
+        let column = Mesh::cylinder(Vec3::new(x, 0.0, -2.0), 0.35, 3.0, 4096);
+        objects.push(object(&format!("column{}", k + 1), column, Material::lambert(0.75)));
+    }
+    let boxes = [
+        (Vec3::new(-2.5, 0.0, -3.0), Vec3::new(-1.0, 1.2, -2.0), Material::lambert(0.6)),
+        (
+            Vec3::new(1.0, 0.0, -3.2),
+            Vec3::new(2.6, 0.8, -2.2),
+            Material { albedo: Vec3::splat(0.25), specular: ggx(0.3, Vec3::splat(0.5)) },
+        ),
+    ];
+    for (k, (lo, hi, material)) in boxes.into_iter().enumerate() {
+        objects.push(object(&format!("box{}", k + 1), Mesh::tessellated_cuboid(lo, hi, 16), material));
+    }
+    Scene {
+        name: "gallery".into(),
+        objects,
+        camera: camera(Vec3::new(0.0, 2.8, 8.5), Vec3::new(0.0, 0.6, -0.5), 55.0),
         point_lights: vec![],
     }
 }

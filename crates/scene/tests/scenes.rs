@@ -29,6 +29,8 @@ fn triangle_counts_match_the_papers_scenes() {
     assert_eq!(count("three_boxes"), 38);
     assert!((420..=460).contains(&count("column")), "column: {}", count("column"));
     assert!(count("room") > 3000, "room walls are finely tessellated");
+    // paper 001's Unity scene: 161.8k triangles
+    assert_eq!(count("gallery"), 161_794);
 }
 
 #[test]

@@ -7,10 +7,12 @@ use super::{MaskRow, Plan};
 use envmap_sphere::EnvMap;
 use glam::Vec3;
 use gpu::{
-    Background, GBufferPass, Gpu, LightShape, PrecomputedVisibility, Receivers, SceneGeometry, ShadeLight, ShadeParams,
-    ShadingPass, ShadowGeometry, ShadowTechnique, Visibility, WEBER_FRACTION, downsample_box, render_visibility,
-    weber_negligible,
+    Background, GBufferPass, Gpu, InterleavePass, JointBilateral, LightShape, PrecomputedVisibility, PrefilterSettings,
+    Receivers, SceneGeometry, ShadeLight, ShadeParams, ShadingPass, ShadowGeometry, ShadowTechnique, SpecularAmbient,
+    SplitFrame, SplitPasses, SplitSettings, UpsamplePass, Visibility, WEBER_FRACTION, downsample_box, render_split,
+    render_visibility, weber_negligible,
 };
+use light_extract::ExtractedLight;
 use penumbra_wedge::{WedgeSettings, Wedges};
 use ref_tracer::SceneBvh;
 use ref_tracer::visibility::{AreaLight, VisibilityLight, area_light_visibility_refined, light_visibility};
@@ -117,11 +119,22 @@ pub(super) fn gpu_render(
     let (w, h) = gb.size();
     let pass = &passes.shading;
     let background = Background::upload(gpu, map).map_err(e)?;
+    // the ambient map on the specular lobe, for scenes that have one
+    let glossy = scene.objects.iter().any(|o| o.material.specular.is_some());
+    let specular = if glossy {
+        Some(SpecularAmbient::new(gpu, &d.ambient, &PrefilterSettings::default()).map_err(e)?)
+    } else {
+        None
+    };
+    let ambient = match &specular {
+        Some(_) => "SH9 + prefiltered specular ambient",
+        None => "SH9 ambient (no glossy surface: no specular prefiltering)",
+    };
     let params = ShadeParams {
         lights: &lights,
         ambient: Some(&d.ambient_sh),
         background: Some(&background),
-        ..Default::default()
+        specular_ambient: specular.as_ref(),
     };
     let common = start.elapsed().as_secs_f64();
     let mut out = Vec::new();
@@ -132,24 +145,94 @@ pub(super) fn gpu_render(
     ));
     // lights whose shadow no visible receiver could tell apart (Weber's law) get no pass
     let negligible = weber_negligible(&receivers, &lights, Some(&d.ambient_sh), WEBER_FRACTION);
-    for (name, technique) in all {
+    let mut wedges = None;
+    for (name, technique) in &all {
         let t = Instant::now();
         let vis = Visibility::new(gpu, w, h, lights.len() as u32).map_err(e)?;
         let reports = render_visibility(gpu, technique.as_ref(), &receivers, &shapes, &negligible, &vis).map_err(e)?;
         let image = downsample_box(&pass.render(gpu, &geometry, &gb, &params, &vis).map_err(e)?, size, ss);
         let (time, shadowed, _, _) = gpu::totals(&reports);
         let shadow_ms = time.as_secs_f64() * 1e3;
+        let seconds = common + t.elapsed().as_secs_f64();
         out.push(GpuImage {
             what: format!(
-                "GPU: {} lights with {} ({shadowed} shadowed{}; {shadow_ms:.1} ms), + SH9 ambient",
+                "GPU: {} lights with {} ({shadowed} shadowed{}; {shadow_ms:.1} ms), + {ambient}",
                 lights.len(),
                 technique.name(),
                 skip_summary(&reports),
             ),
-            name,
+            name: name.clone(),
             image,
-            seconds: common + t.elapsed().as_secs_f64(),
+            seconds,
         });
+        if name == "gpu_wedges" {
+            wedges = Some((technique.as_ref(), vis, reports, seconds));
+        }
+    }
+    let directs = d.lights.iter().filter(|l| !l.indirect).count();
+    if let Some((technique, vis, reports, seconds)) = wedges
+        && directs < lights.len()
+    {
+        // paper 001's frame: the EnvDirects' wedges at full resolution (the layers above),
+        // the EnvIndirects' at 1/2 or 1/4 of the output's resolution, upsampled
+        let frame = SplitFrame {
+            lights: &lights,
+            shapes: &shapes,
+            directs,
+            ambient: Some(&d.ambient_sh),
+            specular_ambient: specular.as_ref(),
+            background: Some(&background),
+        };
+        let upsample_pass = UpsamplePass::new(gpu);
+        let split_passes = SplitPasses { gbuffer: &passes.gbuffer, shading: pass, upsample: &upsample_pass };
+        let direct_ms = gpu::totals(&reports[..directs]).0.as_secs_f64() * 1e3;
+        let all_ms = gpu::totals(&reports).0.as_secs_f64() * 1e3;
+        for (suffix, scale, upsample, how) in [
+            ("half", 2, JointBilateral::PAPER, "joint bilateral"),
+            ("quarter", 4, JointBilateral::PAPER, "joint bilateral"),
+            ("half_gaussian", 2, JointBilateral::GAUSSIAN, "Gaussian"),
+        ] {
+            let t = Instant::now();
+            let settings = SplitSettings { indirect_scale: scale * ss, upsample };
+            let split = render_split(gpu, &split_passes, &geometry, (&receivers, &vis), &frame, technique, &settings)
+                .map_err(e)?;
+            let image = downsample_box(&gpu::read_hdr(gpu, &split.texture).map_err(e)?, size, ss);
+            let indirect_ms = gpu::totals(&split.indirect_reports).0.as_secs_f64() * 1e3;
+            let (lw, lh) = split.indirect_size;
+            out.push(GpuImage {
+                name: format!("gpu_wedges_indirects_{suffix}"),
+                what: format!(
+                    "GPU, paper 001's split: {directs} EnvDirects with wedges at full resolution ({direct_ms:.1} ms), {} EnvIndirects with wedges at {lw}x{lh} ({indirect_ms:.1} ms{}), {how} upsampling, + {ambient}",
+                    lights.len() - directs,
+                    skip_summary(&split.indirect_reports),
+                ),
+                image,
+                // the wedges row's common work and its directs' share of the shadow work, and this
+                // frame's own
+                seconds: common + (seconds - common) * direct_ms / all_ms.max(1e-9) + t.elapsed().as_secs_f64(),
+            });
+        }
+    }
+    if plan.interleaved {
+        let sets: Vec<Vec<ExtractedLight>> = std::iter::once(d.lights.clone()).chain(d.interleaved()).collect();
+        for (name, technique) in all.iter().filter(|(n, _)| n == "gpu_shadow_maps" || n == "gpu_wedges") {
+            let t = Instant::now();
+            let frame = Frame { geometry: &geometry, receivers: &receivers, params: &params, negligible: &negligible };
+            let (image, ms) = interleaved(gpu, pass, &frame, technique.as_ref(), &sets).map_err(e)?;
+            out.push(GpuImage {
+                name: format!("{name}_interleaved"),
+                what: format!(
+                    "GPU: {} lights in {} interleaved sets (a {}x{} pixel tile) with {} ({ms:.1} ms), + {ambient}",
+                    lights.len(),
+                    sets.len(),
+                    gpu::interleave_tile(sets.len() as u32).0,
+                    gpu::interleave_tile(sets.len() as u32).1,
+                    technique.name()
+                ),
+                image: downsample_box(&image, size, ss),
+                seconds: common + t.elapsed().as_secs_f64(),
+            });
+        }
     }
     let lit = Visibility::new(gpu, w, h, lights.len() as u32).map_err(e)?;
     let unshadowed = downsample_box(&pass.render(gpu, &geometry, &gb, &params, &lit).map_err(e)?, size, ss);
@@ -160,6 +243,42 @@ pub(super) fn gpu_render(
         seconds: 0.0,
     });
     Ok(out)
+}
+
+/// What every set of an interleaved frame shares.
+struct Frame<'a> {
+    geometry: &'a SceneGeometry,
+    receivers: &'a Receivers<'a>,
+    params: &'a ShadeParams<'a>,
+    negligible: &'a [bool],
+}
+
+/// Paper 001's interleaved sampling on the GPU: each light set shadowed by `technique` and
+/// shaded whole, its pixels of the interleaving tile gathered into one image. Returns the image
+/// and the shadow passes' time in ms.
+fn interleaved(
+    gpu: &Gpu,
+    pass: &ShadingPass,
+    frame: &Frame,
+    technique: &dyn ShadowTechnique,
+    sets: &[Vec<ExtractedLight>],
+) -> Result<(Vec<Vec3>, f64), gpu::GpuError> {
+    let gb = frame.receivers.gbuffer;
+    let (w, h) = gb.size();
+    let gathered = gpu::render_target(gpu, "interleaved", (w, h, 1), gpu::HDR_FORMAT)?;
+    let gather = InterleavePass::new(gpu);
+    let mut ms = 0.0;
+    for (k, set) in sets.iter().enumerate() {
+        let lights: Vec<ShadeLight> = set.iter().map(|l| ShadeLight::from(&l.light)).collect();
+        let shapes: Vec<LightShape> = set.iter().map(|l| LightShape::from(&l.light)).collect();
+        let vis = Visibility::new(gpu, w, h, lights.len() as u32)?;
+        let reports = render_visibility(gpu, technique, frame.receivers, &shapes, frame.negligible, &vis)?;
+        ms += gpu::totals(&reports).0.as_secs_f64() * 1e3;
+        let params = ShadeParams { lights: &lights, ..*frame.params };
+        let image = pass.render_texture(gpu, frame.geometry, gb, &params, &vis)?;
+        gather.gather(gpu, &image, &gathered, sets.len() as u32, k as u32)?;
+    }
+    Ok((gpu::read_hdr(gpu, &gathered)?, ms))
 }
 
 /// ", N skipped: why" per reason, or nothing.

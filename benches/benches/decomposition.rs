@@ -1,0 +1,29 @@
+//! Paper 001's whole frame on the GPU (`envshadow_benches::decomposition`): time per frame on
+//! `gallery` (161,794 triangles) at 1600 x 1200 with the EnvIndirects at full, half and quarter
+//! resolution. Wall time, CPU work of the frame included. Under `cargo test` (one smoke run)
+//! the frame is 400 x 300.
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use envshadow_benches::decomposition::Frame;
+use gpu::Gpu;
+use std::time::Duration;
+
+fn decomposition(c: &mut Criterion) {
+    let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
+    // criterion passes --bench when benchmarking; a smoke run gets a small frame
+    let size = if std::env::args().any(|a| a == "--bench") { (1600, 1200) } else { (400, 300) };
+    let frame = Frame::new(&gpu, "gallery", size, 32).unwrap_or_else(|e| panic!("{e}"));
+    let mut group = c.benchmark_group(format!("decomposition_gallery_{}x{}", size.0, size.1));
+    group.sample_size(10);
+    for (name, scale) in [("indirects_full", 1), ("indirects_half", 2), ("indirects_quarter", 4)] {
+        group.bench_function(name, |b| {
+            b.iter_custom(|iters| {
+                (0..iters).map(|_| frame.render(&gpu, scale).map_or(Duration::MAX, |(t, _)| t)).sum()
+            });
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, decomposition);
+criterion_main!(benches);

@@ -1,0 +1,101 @@
+//! Paper 001's frame on the GPU, whole: the G-buffer, the EnvDirects' soft shadows (wedges) at
+//! full resolution, the EnvIndirects' shadows (orthographic maps, as paper 001's Unity version)
+//! from a G-buffer at 1 / `scale` of the resolution, joint bilateral upsampling, shading with the
+//! residual's SH9 and prefiltered specular ambient. The criterion bench `decomposition` times it
+//! on `gallery` (161,794 triangles, paper 001's scale).
+
+use gpu::{
+    Background, GBufferPass, Gpu, GpuError, JointBilateral, LightShape, PrefilterSettings, Receivers, SceneGeometry,
+    ShadeLight, ShadingPass, ShadowTechnique, SpecularAmbient, SplitFrame, SplitPasses, SplitSettings, UpsamplePass,
+    Visibility, WEBER_FRACTION, render_split, render_visibility, weber_negligible,
+};
+use light_extract::Decomposition;
+use penumbra_wedge::{WedgeSettings, Wedges};
+use shadowmap_paraboloid::{MapTechnique, ShadowSettings, Technique};
+use std::time::{Duration, Instant};
+
+/// The extraction the frame draws: the toolkit's most accurate (validate's default).
+pub const METHOD: &str = "emissive-split+moment-cones+above-horizon+residual";
+
+/// Everything a frame needs that does not change between frames.
+pub struct Frame {
+    /// The scene, its camera at the frame's size.
+    pub scene: scene::Scene,
+    /// The decomposition of the default map, EnvDirects first.
+    pub decomposition: Decomposition,
+    geometry: SceneGeometry,
+    gbuffer: GBufferPass,
+    shading: ShadingPass,
+    upsample: UpsamplePass,
+    background: Background,
+    specular: SpecularAmbient,
+    wedges: Wedges,
+    maps: MapTechnique,
+}
+
+impl Frame {
+    /// Sets up `scene_name` at `size`, lit by the default map decomposed into `lights` lights.
+    ///
+    /// # Errors
+    /// An unknown scene or method; GPU failures.
+    pub fn new(gpu: &Gpu, scene_name: &str, size: (u32, u32), lights: usize) -> Result<Self, String> {
+        let e = |e: GpuError| e.to_string();
+        let mut scene = scene::Scene::builtin(scene_name).map_err(|e| e.to_string())?;
+        (scene.camera.width, scene.camera.height) = size;
+        let map = crate::bench_map();
+        let extractor = light_extract::extractor(METHOD, lights).ok_or("unknown method")?;
+        let mut decomposition = extractor.extract(&map).map_err(|e| e.to_string())?;
+        decomposition.lights.sort_by_key(|l| l.indirect);
+        let maps_settings = ShadowSettings { resolution: 1024, pcf_radius: 1, ..ShadowSettings::default() };
+        Ok(Self {
+            geometry: SceneGeometry::upload(gpu, &scene).map_err(e)?,
+            gbuffer: GBufferPass::new(gpu),
+            shading: ShadingPass::new(gpu).map_err(e)?,
+            upsample: UpsamplePass::new(gpu),
+            background: Background::upload(gpu, &map).map_err(e)?,
+            specular: SpecularAmbient::new(gpu, &decomposition.ambient, &PrefilterSettings::default()).map_err(e)?,
+            wedges: Wedges::new(gpu, &scene, WedgeSettings::default()),
+            maps: MapTechnique::new(gpu, &scene, Technique::Orthographic, maps_settings, 1).map_err(e)?,
+            scene,
+            decomposition,
+        })
+    }
+
+    /// Renders one frame with the EnvIndirects at 1 / `scale` and returns its wall time (GPU
+    /// work waited for, CPU work included) and the image.
+    ///
+    /// # Errors
+    /// GPU failures; a scale that does not divide the size.
+    pub fn render(&self, gpu: &Gpu, scale: u32) -> Result<(Duration, wgpu::Texture), GpuError> {
+        let start = Instant::now();
+        let d = &self.decomposition;
+        let lights: Vec<ShadeLight> = d.lights.iter().map(|l| ShadeLight::from(&l.light)).collect();
+        let shapes: Vec<LightShape> = d.lights.iter().map(|l| LightShape::from(&l.light)).collect();
+        let directs = d.lights.iter().filter(|l| !l.indirect).count();
+        let gb = self.gbuffer.render(gpu, &self.geometry, &self.scene.camera)?;
+        let points = gb.read_points(gpu)?;
+        let receivers = Receivers::new(&gb, &points);
+        let (w, h) = gb.size();
+        let vis = Visibility::new(gpu, w, h, directs as u32)?;
+        let negligible = weber_negligible(&receivers, &lights, Some(&d.ambient_sh), WEBER_FRACTION);
+        let wedges: &dyn ShadowTechnique = &self.wedges;
+        render_visibility(gpu, wedges, &receivers, &shapes[..directs], &negligible[..directs], &vis)?;
+        let split = render_split(
+            gpu,
+            &SplitPasses { gbuffer: &self.gbuffer, shading: &self.shading, upsample: &self.upsample },
+            &self.geometry,
+            (&receivers, &vis),
+            &SplitFrame {
+                lights: &lights,
+                shapes: &shapes,
+                directs,
+                ambient: Some(&d.ambient_sh),
+                specular_ambient: Some(&self.specular),
+                background: Some(&self.background),
+            },
+            &self.maps,
+            &SplitSettings { indirect_scale: scale, upsample: JointBilateral::PAPER },
+        )?;
+        Ok((start.elapsed(), split.texture))
+    }
+}
