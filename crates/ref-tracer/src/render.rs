@@ -87,7 +87,8 @@ pub fn render(
     let tiles: Vec<(u32, u32)> =
         (0..h.div_ceil(TILE)).flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE))).collect();
     let mut sum = vec![Vec3::ZERO; n];
-    let pass_size = (settings.spp / 16).max(1);
+    // with a time budget a pass is one sample, so the budget is overshot by one pass at most
+    let pass_size = if settings.time_budget.is_some() { 1 } else { (settings.spp / 16).max(1) };
     let mut done = 0u32;
     while done < settings.spp {
         let count = pass_size.min(settings.spp - done);

@@ -457,3 +457,20 @@ fn images_do_not_depend_on_the_scenes_scale() {
         assert!(e < 1e-4, "scale {s}: relative RMSE {e}");
     }
 }
+
+#[test]
+fn a_time_budget_stops_after_the_pass_that_passes_it() {
+    // a budget far below what the samples asked for: one-sample passes stop the render early,
+    // with every pixel averaged over the same whole number of samples
+    let scene = small("spheres_box", 32, 24);
+    let map = envmap_sphere::default_map().resize(64, 32);
+    let settings = RenderSettings {
+        spp: 1 << 24,
+        time_budget: Some(std::time::Duration::from_millis(50)),
+        aovs: false,
+        ..RenderSettings::default()
+    };
+    let r = run_with(&scene, Some(&map), &Integrator::EnvDirect(ref_tracer::Strategy::Mis), &settings);
+    assert!(r.spp >= 1 && r.spp < 1 << 24, "{} spp", r.spp);
+    assert!(r.color.iter().all(|c| c.is_finite()));
+}

@@ -5,7 +5,8 @@
 //! The block sits between `<!-- validate:begin -->` and `<!-- validate:end -->`. Checked: the
 //! errors of the CPU renders (deterministic for a seed on any machine), and the GPU's errors and
 //! the room's disagreement when the run's adapter is the one the block names (another driver
-//! rasterizes differently). Times are never checked: they are one run's.
+//! rasterizes differently). Times are never checked: they are one run's, and so is the error of
+//! the equal-time row.
 
 use super::{MaskRow, Row};
 use std::fmt::Write as _;
@@ -55,6 +56,7 @@ impl Figures<'_> {
         for r in self.rows {
             if let (Some(rm), Some(fl)) = (r.rmse, r.flip)
                 && (!r.name.starts_with("gpu_") || same_adapter)
+                && r.name != super::EQUAL_TIME_ROW
             {
                 out.push((format!("{} RMSE", r.name), format!("{rm:.4}")));
                 out.push((format!("{} FLIP", r.name), format!("{fl:.4}")));
