@@ -12,7 +12,8 @@ fn decomposition(c: &mut Criterion) {
     let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
     // criterion passes --bench when benchmarking; a smoke run gets a small frame
     let size = if std::env::args().any(|a| a == "--bench") { (1600, 1200) } else { (400, 300) };
-    let frame = Frame::new(&gpu, "gallery", size, 32).unwrap_or_else(|e| panic!("{e}"));
+    let frame =
+        Frame::new(&gpu, "gallery", size, &envshadow_benches::bench_map(), 32).unwrap_or_else(|e| panic!("{e}"));
     let mut group = c.benchmark_group(format!("decomposition_gallery_{}x{}", size.0, size.1));
     group.sample_size(10);
     for (name, scale) in [("indirects_full", 1), ("indirects_half", 2), ("indirects_quarter", 4)] {

@@ -4,6 +4,7 @@
 //! residual's SH9 and prefiltered specular ambient. The criterion bench `decomposition` times it
 //! on `gallery` (161,794 triangles, paper 001's scale).
 
+use envmap_sphere::EnvMap;
 use gpu::{
     Background, GBufferPass, Gpu, GpuError, JointBilateral, LightShape, PrefilterSettings, Receivers, SceneGeometry,
     ShadeLight, ShadingPass, ShadowTechnique, SpecularAmbient, SplitFrame, SplitPasses, SplitSettings, UpsamplePass,
@@ -34,17 +35,16 @@ pub struct Frame {
 }
 
 impl Frame {
-    /// Sets up `scene_name` at `size`, lit by the default map decomposed into `lights` lights.
+    /// Sets up `scene_name` at `size`, lit by `map` decomposed into `lights` lights.
     ///
     /// # Errors
     /// An unknown scene or method; GPU failures.
-    pub fn new(gpu: &Gpu, scene_name: &str, size: (u32, u32), lights: usize) -> Result<Self, String> {
+    pub fn new(gpu: &Gpu, scene_name: &str, size: (u32, u32), map: &EnvMap, lights: usize) -> Result<Self, String> {
         let e = |e: GpuError| e.to_string();
         let mut scene = scene::Scene::builtin(scene_name).map_err(|e| e.to_string())?;
         (scene.camera.width, scene.camera.height) = size;
-        let map = crate::bench_map();
         let extractor = light_extract::extractor(METHOD, lights).ok_or("unknown method")?;
-        let mut decomposition = extractor.extract(&map).map_err(|e| e.to_string())?;
+        let mut decomposition = extractor.extract(map).map_err(|e| e.to_string())?;
         decomposition.lights.sort_by_key(|l| l.indirect);
         let maps_settings = ShadowSettings { resolution: 1024, pcf_radius: 1, ..ShadowSettings::default() };
         Ok(Self {
@@ -52,7 +52,7 @@ impl Frame {
             gbuffer: GBufferPass::new(gpu),
             shading: ShadingPass::new(gpu).map_err(e)?,
             upsample: UpsamplePass::new(gpu),
-            background: Background::upload(gpu, &map).map_err(e)?,
+            background: Background::upload(gpu, map).map_err(e)?,
             specular: SpecularAmbient::new(gpu, &decomposition.ambient, &PrefilterSettings::default()).map_err(e)?,
             wedges: Wedges::new(gpu, &scene, WedgeSettings::default()),
             maps: MapTechnique::new(gpu, &scene, Technique::Orthographic, maps_settings, 1).map_err(e)?,

@@ -93,12 +93,14 @@ fn settings_out_of_range_are_errors() {
 }
 
 /// A residual-like map: a smooth sky, minus a negative disk where a light took too much, plus
-/// a narrow positive spike it missed, and negative over the whole lower half.
+/// a narrow positive spike it missed, negative over most of the sphere (a test checks).
 fn residual_like() -> EnvMap {
     let disk = Vec3::new(0.4, 0.6, 0.5).normalize();
     let spike = Vec3::new(-0.5, 0.5, 0.7).normalize();
     EnvMap::from_fn(256, 128, |d| {
-        let mut v = Vec3::new(0.3, 0.4, 0.6) * (0.2 + 0.8 * d.y.max(0.0)) - Vec3::splat(0.25) * (-d.y).max(0.0);
+        let mut v = Vec3::new(0.3, 0.4, 0.6) * (0.2 + 0.8 * d.y.max(0.0))
+            - Vec3::splat(0.25) * (-d.y).max(0.0)
+            - Vec3::splat(0.15);
         if d.dot(disk) > 0.97 {
             v -= Vec3::splat(1.5);
         }
@@ -111,7 +113,7 @@ fn residual_like() -> EnvMap {
 
 /// GPU and `ref-tracer` images of `scene` lit by `map` as ambient only (SH9 on the diffuse lobe,
 /// the map on the specular lobe), with the object id of each pixel.
-fn ambient_images(scene: &Scene, map: &EnvMap) -> (Vec<Vec3>, Vec<Vec3>, Vec<u32>) {
+fn ambient_images(scene: &Scene, map: &EnvMap) -> (Vec<Vec3>, Vec<Vec3>, Vec<u32>, Vec<Vec3>) {
     let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
     let sh = Sh9::project(map);
     let specular = SpecularAmbient::new(&gpu, map, &PrefilterSettings::default()).unwrap();
@@ -143,7 +145,9 @@ fn ambient_images(scene: &Scene, map: &EnvMap) -> (Vec<Vec3>, Vec<Vec3>, Vec<u32
         &RenderSettings { spp: 64, seed: 3, ..RenderSettings::default() },
         &|_, _| {},
     );
-    (image, reference.color, reference.object_id)
+    let normals =
+        gpu::read_texture_rgba(&gpu, &gb.normal, 0).unwrap().iter().map(|n| Vec3::new(n[0], n[1], n[2])).collect();
+    (image, reference.color, reference.object_id, normals)
 }
 
 fn spheres(materials: &[Material]) -> Scene {
@@ -185,16 +189,42 @@ fn relative_error_per_object(image: &[Vec3], reference: &[Vec3], ids: &[u32], ob
 }
 
 #[test]
-fn signed_sh9_ambient_on_diffuse_surfaces_matches_ref_tracer() {
-    // Lambertian: the GPU's SH9 irradiance is the tracer's, sign and all; only the pixel
-    // sampling differs (ref-tracer jitters within a pixel)
+fn the_residual_like_map_is_negative_over_most_of_the_sphere() {
     let map = residual_like();
-    let scene = spheres(&[Material::lambert(0.8), Material::lambert(0.3)]);
-    let (image, reference, ids) = ambient_images(&scene, &map);
+    let (mut negative, mut all) = (0.0, 0.0);
+    for j in 0..map.height() {
+        let sa = map.texel_solid_angle(j);
+        for i in 0..map.width() {
+            all += sa;
+            if envmap_sphere::luminance(map.pixel(i, j)) < 0.0 {
+                negative += sa;
+            }
+        }
+    }
+    // 62 %
+    assert!(negative / all > 0.6, "negative over {:.0} % of the sphere", 100.0 * negative / all);
+}
+
+#[test]
+fn signed_sh9_ambient_on_diffuse_surfaces_matches_ref_tracer() {
+    // Lambertian: the GPU's SH9 irradiance is the tracer's, sign and all. Per pixel against the
+    // CPU's SH9 at the G-buffer's normal (ref-tracer jitters within pixels, and near zero its
+    // relative error means nothing), and per object against ref-tracer
+    let map = residual_like();
+    let albedo = [0.8, 0.3];
+    let scene = spheres(&albedo.map(Material::lambert));
+    let (image, reference, ids, normals) = ambient_images(&scene, &map);
     let negative = (0..ids.len()).filter(|&k| ids[k] != u32::MAX && reference[k].x < 0.0).count();
     assert!(negative > 500, "the test needs negative irradiance: {negative} pixels");
+    let sh = Sh9::project(&map);
+    let scale = map.pixels().iter().map(|p| p.abs().max_element()).sum::<f32>() / map.pixels().len() as f32;
+    for k in (0..ids.len()).filter(|&k| ids[k] != u32::MAX && normals[k].length() > 0.5) {
+        let cpu = albedo[ids[k] as usize] * sh.irradiance(normals[k]) / std::f32::consts::PI;
+        assert!((image[k] - cpu).abs().max_element() < 1e-4 * scale.max(1.0), "pixel {k}: {} against {cpu}", image[k]);
+    }
     let errors = relative_error_per_object(&image, &reference, &ids, 2);
-    assert!(errors.iter().all(|e| *e < 0.01), "relative errors {errors:?}");
+    // measured 0.008 and 0.022: ref-tracer's jitter within pixels, relative to values near zero
+    assert!(errors.iter().all(|e| *e < 0.03), "relative errors {errors:?}");
 }
 
 #[test]
@@ -211,10 +241,10 @@ fn split_sum_specular_ambient_is_close_to_ref_tracer_exact_integral() {
         ggx(0.8, Vec3::new(0.95, 0.64, 0.54), 0.0),
     ];
     let scene = spheres(&materials);
-    let (image, reference, ids) = ambient_images(&scene, &map);
+    let (image, reference, ids, _) = ambient_images(&scene, &map);
     let errors = relative_error_per_object(&image, &reference, &ids, materials.len() as u32);
     // The split sum's own error (each lobe filtered as if seen along the normal) is all there
-    // is: measured 0.025, 0.019, 0.049 and 0.105 (the rough metal; 0.23 about the mirror
+    // is: measured 0.028, 0.026, 0.050 and 0.114 (the rough metal; twice that about the mirror
     // direction instead of the dominant one).
     assert!(errors[..3].iter().all(|e| *e < 0.06) && errors[3] < 0.13, "relative errors per sphere {errors:?}");
 }
