@@ -95,17 +95,25 @@ fn validate_quick_runs_from_a_copied_binary_and_meets_its_thresholds() {
     let dir = dir.join("out");
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{text}\n{}", String::from_utf8_lossy(&out.stderr));
-    assert!(text.contains("[1/8] load environment map") && text.contains("[8/8] report"), "{text}");
+    assert!(text.contains("[1/9] load environment map") && text.contains("[9/9] report"), "{text}");
     // the adapter is named before any work, and again by the GPU stage
     let first = text.lines().next().unwrap_or_default();
     let adapter = first.strip_prefix("GPU: ").unwrap_or_else(|| panic!("first line {first:?}"));
     let name = adapter.split(" (").next().unwrap_or_default();
-    assert!(text.lines().any(|l| l.contains("[5/8] GPU") && l.contains(name)), "{text}");
+    assert!(text.lines().any(|l| l.contains("[5/9] GPU") && l.contains(name)), "{text}");
     assert!(text.contains("thresholds met") && !text.contains(" 0 thresholds met"), "{text}");
     let html = std::fs::read_to_string(dir.join("report.html")).expect("report written");
     assert!(html.contains("data:image/png;base64,") && !html.contains("src=\"http"), "images embedded");
-    for row in ["reference", "lights_ray_traced", "gpu_shadow_maps", "paraboloid_1024_clip", "cube_592", "GPU adapter"]
-    {
+    for row in [
+        "reference",
+        "lights_ray_traced",
+        "gpu_shadow_maps",
+        "gpu_wedges_indirects_half",
+        "env_direct_equal_time",
+        "paraboloid_1024_clip",
+        "cube_592",
+        "GPU adapter",
+    ] {
         assert!(html.contains(row), "report lacks {row}");
     }
 }
