@@ -1,7 +1,7 @@
 //! Paper 001's whole frame on the GPU (`envshadow_benches::decomposition`): time per frame on
 //! `gallery` (161,794 triangles) at 1600 x 1200 with the EnvIndirects at full, half and quarter
 //! resolution. Wall time, CPU work of the frame included. Under `cargo test` (one smoke run)
-//! the frame is 400 x 300.
+//! the frame is 160 x 120.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use envshadow_benches::decomposition::Frame;
@@ -11,7 +11,7 @@ use std::time::Duration;
 fn decomposition(c: &mut Criterion) {
     let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
     // criterion passes --bench when benchmarking; a smoke run gets a small frame
-    let size = if std::env::args().any(|a| a == "--bench") { (1600, 1200) } else { (400, 300) };
+    let size = if std::env::args().any(|a| a == "--bench") { (1600, 1200) } else { (160, 120) };
     let frame =
         Frame::new(&gpu, "gallery", size, &envshadow_benches::bench_map(), 32).unwrap_or_else(|e| panic!("{e}"));
     let mut group = c.benchmark_group(format!("decomposition_gallery_{}x{}", size.0, size.1));
