@@ -45,7 +45,7 @@ impl Frame {
         (scene.camera.width, scene.camera.height) = size;
         let extractor = light_extract::extractor(METHOD, lights).ok_or("unknown method")?;
         let mut decomposition = extractor.extract(map).map_err(|e| e.to_string())?;
-        decomposition.lights.sort_by_key(|l| l.indirect);
+        decomposition.sort_directs_first();
         let maps_settings = ShadowSettings { resolution: 1024, pcf_radius: 1, ..ShadowSettings::default() };
         Ok(Self {
             geometry: SceneGeometry::upload(gpu, &scene).map_err(e)?,
@@ -71,7 +71,7 @@ impl Frame {
         let d = &self.decomposition;
         let lights: Vec<ShadeLight> = d.lights.iter().map(|l| ShadeLight::from(&l.light)).collect();
         let shapes: Vec<LightShape> = d.lights.iter().map(|l| LightShape::from(&l.light)).collect();
-        let directs = d.lights.iter().filter(|l| !l.indirect).count();
+        let directs = d.directs();
         let gb = self.gbuffer.render(gpu, &self.geometry, &self.scene.camera)?;
         let points = gb.read_points(gpu)?;
         let receivers = Receivers::new(&gb, &points);

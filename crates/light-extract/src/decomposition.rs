@@ -98,6 +98,19 @@ impl Decomposition {
             .fold(0.0, f64::max)
     }
 
+    /// Puts the EnvDirects before the EnvIndirects (order kept within each), as renderers that
+    /// shade the EnvIndirects apart take them; returns how many EnvDirects there are.
+    pub fn sort_directs_first(&mut self) -> usize {
+        self.lights.sort_by_key(|l| l.indirect);
+        self.directs()
+    }
+
+    /// How many lights are not EnvIndirects.
+    #[must_use]
+    pub fn directs(&self) -> usize {
+        self.lights.iter().filter(|l| !l.indirect).count()
+    }
+
     /// The lights as renderers take them.
     #[must_use]
     pub fn distant_lights(&self) -> Vec<DistantLight> {

@@ -551,3 +551,16 @@ fn env_indirects_are_flagged_through_wrappers_and_lights_json() {
     let d = light_extract::extractor("median-cut", 16).unwrap().extract(&map).unwrap();
     assert!(d.lights.iter().all(|l| !l.indirect), "median cut has no EnvIndirects");
 }
+
+#[test]
+fn sorting_puts_env_directs_first_and_counts_them() {
+    let mut d = light_extract::extractor("emissive-split", 32).unwrap().extract(&envmap_sphere::default_map()).unwrap();
+    d.lights.reverse();
+    let before: Vec<_> = d.lights.clone();
+    let n = d.sort_directs_first();
+    assert_eq!(n, before.iter().filter(|l| !l.indirect).count());
+    assert!(d.lights[..n].iter().all(|l| !l.indirect) && d.lights[n..].iter().all(|l| l.indirect));
+    // stable: each group keeps its order
+    let directs: Vec<_> = before.iter().filter(|l| !l.indirect).copied().collect();
+    assert_eq!(d.lights[..n], directs[..]);
+}

@@ -169,7 +169,7 @@ pub(super) fn gpu_render(
             wedges = Some((technique.as_ref(), vis, reports, seconds));
         }
     }
-    let directs = d.lights.iter().filter(|l| !l.indirect).count();
+    let directs = d.directs();
     if let Some((technique, vis, reports, seconds)) = wedges
         && directs < lights.len()
     {

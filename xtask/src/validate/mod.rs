@@ -204,7 +204,7 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
         .ok_or_else(|| format!("unknown method {} (see cargo xtask extract --help)", args.method))?;
     let mut decomposition = extractor.extract(&map).map_err(|e| format!("{map_name}: {e}"))?;
     // the EnvDirects first (renderers that split shade the rest at reduced resolution)
-    decomposition.lights.sort_by_key(|l| l.indirect);
+    decomposition.sort_directs_first();
     let lights = decomposition.distant_lights();
     let sets = decomposition.interleaved_distant_lights();
     let ambient_map = ref_tracer::AmbientMap::new(&decomposition.ambient);
