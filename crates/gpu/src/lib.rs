@@ -22,6 +22,7 @@ mod readback;
 mod shade;
 pub mod shader;
 mod split;
+mod supersample;
 mod target;
 mod technique;
 mod timer;
@@ -37,6 +38,7 @@ pub use interleave::{InterleavePass, interleave_set, interleave_tile};
 pub use readback::{read_texture_f32, read_texture_rgba};
 pub use shade::{Background, HDR_FORMAT, ShadeLight, ShadeParams, ShadingPass, Visibility, downsample_box, read_hdr};
 pub use split::{SplitFrame, SplitImage, SplitPasses, SplitSettings, render_split};
+pub use supersample::RotatedGrid;
 pub use target::{layer_view, render_target};
 pub use technique::{
     LightShape, PrecomputedVisibility, Receivers, ShadowPassReport, ShadowTechnique, WEBER_FRACTION,

@@ -9,8 +9,8 @@ use glam::Vec3;
 use gpu::{
     Background, GBufferPass, Gpu, InterleavePass, JointBilateral, LightShape, PrecomputedVisibility, PrefilterSettings,
     Receivers, SceneGeometry, ShadeLight, ShadeParams, ShadingPass, ShadowGeometry, ShadowTechnique, SpecularAmbient,
-    SplitFrame, SplitPasses, SplitSettings, UpsamplePass, Visibility, WEBER_FRACTION, downsample_box, render_split,
-    render_visibility, weber_negligible,
+    SplitFrame, SplitPasses, SplitSettings, UpsamplePass, Visibility, WEBER_FRACTION, render_split, render_visibility,
+    weber_negligible,
 };
 use light_extract::ExtractedLight;
 use penumbra_wedge::{WedgeSettings, Wedges};
@@ -104,11 +104,12 @@ pub(super) fn gpu_render(
     let e = |e: gpu::GpuError| e.to_string();
     let start = Instant::now();
     // supersampled as the ray tracer's pixels are (box filter): edges alias otherwise, and
-    // their error would hide the shadows'
+    // their error would hide the shadows'. A rotated grid: an ordered one quantizes the
+    // coverage of every horizontal edge (the ground's far edge) to 1/k along the whole row
     let ss = plan.gpu_supersample.max(1);
+    let grid = gpu::RotatedGrid::new(&scene.camera, ss);
     let mut scene = scene.clone();
-    let size = (scene.camera.width, scene.camera.height);
-    (scene.camera.width, scene.camera.height) = (size.0 * ss, size.1 * ss);
+    scene.camera = *grid.camera();
     let scene = &scene;
     let geometry = SceneGeometry::upload(gpu, scene).map_err(e)?;
     let gb = passes.gbuffer.render(gpu, &geometry, &scene.camera).map_err(e)?;
@@ -150,7 +151,7 @@ pub(super) fn gpu_render(
         let t = Instant::now();
         let vis = Visibility::new(gpu, w, h, lights.len() as u32).map_err(e)?;
         let reports = render_visibility(gpu, technique.as_ref(), &receivers, &shapes, &negligible, &vis).map_err(e)?;
-        let image = downsample_box(&pass.render(gpu, &geometry, &gb, &params, &vis).map_err(e)?, size, ss);
+        let image = grid.resolve(&pass.render(gpu, &geometry, &gb, &params, &vis).map_err(e)?);
         let (time, shadowed, _, _) = gpu::totals(&reports);
         let shadow_ms = time.as_secs_f64() * 1e3;
         let seconds = common + t.elapsed().as_secs_f64();
@@ -196,13 +197,14 @@ pub(super) fn gpu_render(
             let settings = SplitSettings { indirect_scale: scale * ss, upsample };
             let split = render_split(gpu, &split_passes, &geometry, (&receivers, &vis), &frame, technique, &settings)
                 .map_err(e)?;
-            let image = downsample_box(&gpu::read_hdr(gpu, &split.texture).map_err(e)?, size, ss);
+            let image = grid.resolve(&gpu::read_hdr(gpu, &split.texture).map_err(e)?);
             let indirect_ms = gpu::totals(&split.indirect_reports).0.as_secs_f64() * 1e3;
             let (lw, lh) = split.indirect_size;
+            let pitch = f64::from(scale * ss) / f64::from(grid.samples_per_pixel()).sqrt();
             out.push(GpuImage {
                 name: format!("gpu_wedges_indirects_{suffix}"),
                 what: format!(
-                    "GPU, paper 001's split: {directs} EnvDirects with wedges at full resolution ({direct_ms:.1} ms), {} EnvIndirects with wedges at {lw}x{lh} ({indirect_ms:.1} ms{}), {how} upsampling, + {ambient}",
+                    "GPU, paper 001's split: {directs} EnvDirects with wedges at full resolution ({direct_ms:.1} ms), {} EnvIndirects with wedges at {lw}x{lh} (a sample every {pitch:.2} pixels; {indirect_ms:.1} ms{}), {how} upsampling, + {ambient}",
                     lights.len() - directs,
                     skip_summary(&split.indirect_reports),
                 ),
@@ -229,13 +231,13 @@ pub(super) fn gpu_render(
                     gpu::interleave_tile(sets.len() as u32).1,
                     technique.name()
                 ),
-                image: downsample_box(&image, size, ss),
+                image: grid.resolve(&image),
                 seconds: common + t.elapsed().as_secs_f64(),
             });
         }
     }
     let lit = Visibility::new(gpu, w, h, lights.len() as u32).map_err(e)?;
-    let unshadowed = downsample_box(&pass.render(gpu, &geometry, &gb, &params, &lit).map_err(e)?, size, ss);
+    let unshadowed = grid.resolve(&pass.render(gpu, &geometry, &gb, &params, &lit).map_err(e)?);
     out.push(GpuImage {
         name: "gpu_unshadowed".into(),
         what: "GPU: the same lights without shadows".into(),
