@@ -5,7 +5,13 @@
 //! joining planes, exactly the boxes' convex hull) and its conservative box test.
 
 mod aabb;
+mod hierarchy;
 mod shaft;
+mod tree;
 
 pub use aabb::Aabb;
+pub use hierarchy::{
+    BuildError, Kind, Occlusion, Receiver, Representative, Settings, ShaftHierarchy, ShaftNode, Transfers, Traversal,
+};
 pub use shaft::{Overlap, Plane, Shaft};
+pub use tree::{Node, SourceShape, Tree, cone_directions, receiver_octree, source_tree};
