@@ -1,0 +1,143 @@
+//! The radiosity solution that stands in for a capture's radiances: every patch's outgoing
+//! radiance L_p = E_p + ρ_p (Σ_q F_pq V_pq L_q + L_env,p), gathered by Jacobi iteration. Form
+//! factors are point-to-patch from each patch's centre (exact contour integrals, so they sum to
+//! 1 in a closed room); visibility is the fraction of sample points of q the centre sees; the
+//! environment's share is a cosine-weighted stratified estimate of the rays that escape.
+
+use envmap_sphere::EnvMap;
+use glam::Vec3;
+use rayon::prelude::*;
+
+use crate::formfactor::point_to_polygon;
+use crate::{RealScene, RealSceneError, Visibility};
+
+/// Knobs of [`solve`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SolveSettings {
+    /// Iterations at most.
+    pub max_iterations: u32,
+    /// Stop when no patch's radiance changed by more than this fraction of the largest.
+    pub tolerance: f32,
+    /// n x n points on each patch for the visibility of a link.
+    pub visibility_samples: u32,
+    /// n x n cosine-weighted directions per patch for the environment.
+    pub environment_samples: u32,
+}
+
+impl Default for SolveSettings {
+    fn default() -> Self {
+        Self { max_iterations: 200, tolerance: 1e-5, visibility_samples: 2, environment_samples: 16 }
+    }
+}
+
+/// What [`solve`] did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SolveReport {
+    /// Jacobi iterations run.
+    pub iterations: u32,
+    /// The last iteration's largest change, relative to the largest radiance.
+    pub change: f32,
+    /// Patch pairs with a non-zero form factor.
+    pub links: usize,
+}
+
+/// Solves the scene's radiances in place (each patch's `radiance`), lit by its emitting
+/// patches and, when `environment` is given, the map (seen through whatever the patches leave
+/// open).
+///
+/// # Errors
+/// [`RealSceneError::NeedsEnvironment`] for an environment-lit scene without a map.
+pub fn solve(
+    scene: &mut RealScene,
+    vis: &impl Visibility,
+    environment: Option<&EnvMap>,
+    settings: &SolveSettings,
+) -> Result<SolveReport, RealSceneError> {
+    if scene.environment_lit && environment.is_none() {
+        return Err(RealSceneError::NeedsEnvironment(scene.name.clone()));
+    }
+    let patches = &scene.patches;
+    let eps = vis.epsilon();
+    let nv = settings.visibility_samples.max(1);
+    let frames: Vec<(Vec3, Vec3)> = patches.iter().map(|p| (p.center(), p.normal())).collect();
+    // links: (q, F_pq V_pq) per p
+    let links: Vec<Vec<(u32, f32)>> = frames
+        .par_iter()
+        .enumerate()
+        .map(|(k, &(c, n))| {
+            let origin = c + n * eps;
+            let mut out = Vec::new();
+            for (q, patch) in patches.iter().enumerate() {
+                let (cq, nq) = frames[q];
+                // one-sided: q must face p, and lie (partly) above p's plane
+                if q == k || nq.dot(c - cq) <= 0.0 {
+                    continue;
+                }
+                let f = point_to_polygon(origin, n, &patch.corners);
+                if f <= 0.0 {
+                    continue;
+                }
+                let mut seen = 0;
+                for j in 0..nv {
+                    for i in 0..nv {
+                        let target = patch.point((i as f32 + 0.5) / nv as f32, (j as f32 + 0.5) / nv as f32) + nq * eps;
+                        seen += u32::from(vis.clear(origin, target));
+                    }
+                }
+                if seen > 0 {
+                    out.push((q as u32, f * seen as f32 / (nv * nv) as f32));
+                }
+            }
+            out
+        })
+        .collect();
+    // what each patch reflects of the environment: ρ times the mean radiance of the escaping
+    // cosine-weighted directions (E / π)
+    let ne = settings.environment_samples.max(1);
+    let env: Vec<Vec3> = match environment {
+        None => vec![Vec3::ZERO; patches.len()],
+        Some(map) => frames
+            .par_iter()
+            .map(|&(c, n)| {
+                let origin = c + n * eps;
+                let (t, b) = n.any_orthonormal_pair();
+                let mut sum = Vec3::ZERO;
+                for j in 0..ne {
+                    for i in 0..ne {
+                        let (u1, u2) = ((i as f32 + 0.5) / ne as f32, (j as f32 + 0.5) / ne as f32);
+                        let r = u1.sqrt();
+                        let phi = u2 * std::f32::consts::TAU;
+                        let d =
+                            (t * (r * phi.cos()) + b * (r * phi.sin()) + n * (1.0 - u1).max(0.0).sqrt()).normalize();
+                        if vis.escapes(origin, d) {
+                            sum += map.lookup(d);
+                        }
+                    }
+                }
+                sum / (ne * ne) as f32
+            })
+            .collect(),
+    };
+    let base: Vec<Vec3> = patches.iter().zip(&env).map(|(p, e)| p.emission + p.reflectance * *e).collect();
+    let mut radiance = base.clone();
+    let (mut iterations, mut change) = (0, f32::INFINITY);
+    while iterations < settings.max_iterations && change > settings.tolerance {
+        let next: Vec<Vec3> = links
+            .par_iter()
+            .enumerate()
+            .map(|(k, l)| {
+                let gathered: Vec3 = l.iter().map(|&(q, f)| radiance[q as usize] * f).sum();
+                base[k] + patches[k].reflectance * gathered
+            })
+            .collect();
+        let peak = next.iter().map(|v| v.max_element()).fold(0.0f32, f32::max).max(f32::MIN_POSITIVE);
+        change = next.iter().zip(&radiance).map(|(a, b)| (*a - *b).abs().max_element()).fold(0.0, f32::max) / peak;
+        radiance = next;
+        iterations += 1;
+    }
+    let links_count = links.iter().map(Vec::len).sum();
+    for (p, l) in scene.patches.iter_mut().zip(radiance) {
+        p.radiance = l;
+    }
+    Ok(SolveReport { iterations, change, links: links_count })
+}
