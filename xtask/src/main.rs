@@ -18,6 +18,7 @@ mod info;
 mod lavapipe;
 mod render;
 mod scene;
+mod shafts;
 mod soft_shadows;
 mod test;
 mod validate;
@@ -152,6 +153,32 @@ enum Command {
         #[arg(long, default_value = "target/soft-shadows")]
         out: PathBuf,
     },
+    /// Paper 003's shaft hierarchy on a built-in real scene (ar_room, ar_ground): radiosity
+    /// solve, pre-processing (source set, receivers, transfers, shafts), the brute-force
+    /// conservativeness check along a built-in object path, per-frame traversal time, and
+    /// OUT/<scene>_overlay.png (sources red, receivers blue, the object yellow). Exits 1 on a
+    /// missed occluder.
+    Shafts {
+        /// The built-in real scene.
+        #[arg(long, default_value = "ar_room")]
+        scene: String,
+        /// One JSON object: patches, sources, receivers, leaf_shafts, bytes, preprocess_s,
+        /// traversal_us, segments_checked, misses (and more).
+        #[arg(long)]
+        json: bool,
+        /// Share of the total power the source set carries.
+        #[arg(long, default_value_t = 0.7)]
+        source_share: f32,
+        /// Receiver patches per octree leaf at most.
+        #[arg(long, default_value_t = 8)]
+        leaf_size: usize,
+        /// Prune a pair below this fraction of every reached vertex's radiance.
+        #[arg(long, default_value_t = 0.02)]
+        prune: f32,
+        /// Output folder of the overlay image.
+        #[arg(long, default_value = "target/shafts")]
+        out: PathBuf,
+    },
     /// Print an environment map's size, format, luminance, power and SH9 coefficients.
     Info {
         /// The map (.exr or .hdr).
@@ -174,6 +201,15 @@ fn main() -> ExitCode {
         Command::Validate(args) => validate::run(&args),
         Command::Test { adapter, args } => test::run(adapter.as_deref(), &args),
         Command::Info { path, json } => info::run(&path, json),
+        Command::Shafts { scene, json, source_share, leaf_size, prune, out } => {
+            let hierarchy = shaft_hierarchy::Settings { leaf_size, prune_fraction: prune, distant_reach: None };
+            let settings = shaft_hierarchy::preprocess::PreprocessSettings {
+                source_share,
+                hierarchy,
+                ..shaft_hierarchy::preprocess::PreprocessSettings::PAPER
+            };
+            shafts::run(&shafts::ShaftsArgs { scene: &scene, json, settings, out: &out })
+        }
         Command::SoftShadows { scenes, size, adapter, out } => {
             soft_shadows::run(&scenes, size, adapter.as_deref(), &out)
         }

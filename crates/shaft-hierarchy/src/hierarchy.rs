@@ -7,8 +7,9 @@
 use std::collections::BinaryHeap;
 use std::ops::Range;
 
+use crate::shaft::{Meet, meets};
 use crate::tree::{Node, SourceShape, Tree, receiver_octree, source_tree};
-use crate::{Aabb, Overlap, Shaft};
+use crate::{Aabb, Shaft};
 
 /// A receiver patch: its box and its vertices' columns of the transfer matrix.
 #[derive(Clone, Debug, PartialEq)]
@@ -67,28 +68,32 @@ impl Default for Settings {
 /// What a shaft node is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Kind {
-    /// Split further: its children are `shafts[child..child + children]`.
-    Inner,
+    /// Split into the source node's children (`shafts[child..child + children]`, the
+    /// pruned ones left out).
+    SplitSource,
+    /// Split into the receiver node's children.
+    SplitReceiver,
     /// Both nodes are leaves: one source, at most `leaf_size` receivers.
     Leaf,
-    /// Its transfer is below the pruning threshold at every receiver vertex: not refined, and
-    /// not reported as occluding.
-    Pruned,
 }
 
 /// A node of the shaft hierarchy: a pair of a source node and a receiver node. Its planes are
-/// not stored; they are recomputed from the two nodes' boxes when traversed.
+/// not stored; they are recomputed from the two nodes' boxes when traversed. Pairs the pruning
+/// rule removed are not nodes: their parent marks them in `pruned`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ShaftNode {
     /// Source-tree node.
     pub source: u32,
     /// Receiver-tree node.
     pub receiver: u32,
-    /// First child shaft (inner nodes).
+    /// Split nodes: the first stored child shaft. Leaves: the index of their transfer in
+    /// [`ShaftHierarchy::leaf_transfer`].
     pub child: u32,
-    /// Number of children (inner nodes).
+    /// Split nodes: number of stored (not pruned) children.
     pub children: u8,
-    /// Inner, leaf or pruned.
+    /// Split nodes: bit c set when the split node's c-th tree child was pruned.
+    pub pruned: u8,
+    /// How it splits, or a leaf.
     pub kind: Kind,
 }
 
@@ -114,8 +119,15 @@ pub struct ShaftHierarchy {
     pub source_tree: Tree,
     /// Octree over receivers.
     pub receiver_tree: Tree,
-    /// Shaft nodes; the root (both roots) at 0; children consecutive.
+    /// Shaft nodes; the root (both roots) at 0; children consecutive. Empty when there is
+    /// nothing to join, or when the root pair itself is pruned (`root_pruned`).
     pub shafts: Vec<ShaftNode>,
+    /// Per source, the source-tree leaf holding it.
+    pub source_leaf: Vec<u32>,
+    /// Per leaf shaft, its source's transfer to its receivers' vertices (summed).
+    pub leaf_transfer: Vec<f32>,
+    /// True when the whole transfer is below the pruning threshold.
+    pub root_pruned: bool,
     /// Per source-tree node, per receiver vertex: the node's summed transfer.
     node_transfer: Vec<f32>,
     slots: usize,
@@ -133,8 +145,9 @@ pub struct Occlusion {
     pub receivers: Vec<u32>,
     /// Leaf shafts it meets.
     pub leaf_shafts: Vec<u32>,
-    /// Pruned shafts it meets (their transfer is ignored: below the threshold).
-    pub pruned_shafts: Vec<u32>,
+    /// Pruned pairs (source node, receiver node) whose parent shaft it meets: their transfer
+    /// is below the threshold, so it is not reported as occluded.
+    pub pruned: Vec<(u32, u32)>,
     /// Shaft nodes tested.
     pub tested: usize,
 }
@@ -200,6 +213,14 @@ impl ShaftHierarchy {
             return Err(BuildError::NotFinite("a transfer or total".into()));
         }
         let source_tree = source_tree(sources);
+        let mut source_leaf = vec![0u32; sources.len()];
+        for (k, n) in source_tree.nodes.iter().enumerate() {
+            if n.is_leaf() {
+                for &j in source_tree.items(k as u32) {
+                    source_leaf[j as usize] = k as u32;
+                }
+            }
+        }
         let receiver_boxes: Vec<Aabb> = receivers.iter().map(|r| r.bounds).collect();
         let receiver_tree = receiver_octree(&receiver_boxes, settings.leaf_size);
         let reach = settings.distant_reach.unwrap_or_else(|| {
@@ -237,6 +258,9 @@ impl ShaftHierarchy {
             source_tree,
             receiver_tree,
             shafts: Vec::new(),
+            source_leaf,
+            leaf_transfer: Vec::new(),
+            root_pruned: false,
             node_transfer,
             slots,
             totals: transfers.totals.clone(),
@@ -251,36 +275,68 @@ impl ShaftHierarchy {
 
     /// Breadth first, so that each node's children are consecutive.
     fn build_shafts(&mut self) {
-        self.shafts.push(ShaftNode { source: 0, receiver: 0, child: 0, children: 0, kind: Kind::Inner });
+        if self.negligible(0, 0) {
+            self.root_pruned = true;
+            return;
+        }
+        self.shafts.push(ShaftNode { source: 0, receiver: 0, child: 0, children: 0, pruned: 0, kind: Kind::Leaf });
         let mut k = 0;
         while k < self.shafts.len() {
             let ShaftNode { source, receiver, .. } = self.shafts[k];
             let (s, r) = (self.source_tree.nodes[source as usize], self.receiver_tree.nodes[receiver as usize]);
-            let kind = if self.negligible(source, receiver) {
-                Kind::Pruned
-            } else if s.is_leaf() && r.is_leaf() {
-                Kind::Leaf
-            } else {
-                Kind::Inner
-            };
-            self.shafts[k].kind = kind;
-            if kind == Kind::Inner {
-                let split_source =
-                    !s.is_leaf() && (r.is_leaf() || self.source_size(&s, &r) >= r.bounds.size().length());
-                let child = self.shafts.len() as u32;
-                if split_source {
-                    for c in self.source_tree.children(source) {
-                        self.shafts.push(ShaftNode { source: c, receiver, child: 0, children: 0, kind: Kind::Inner });
-                    }
-                } else {
-                    for c in self.receiver_tree.children(receiver) {
-                        self.shafts.push(ShaftNode { source, receiver: c, child: 0, children: 0, kind: Kind::Inner });
-                    }
-                }
-                self.shafts[k].child = child;
-                self.shafts[k].children = (self.shafts.len() as u32 - child) as u8;
+            if s.is_leaf() && r.is_leaf() {
+                let sum = self
+                    .receiver_tree
+                    .items(receiver)
+                    .iter()
+                    .flat_map(|&p| self.receivers[p as usize].slots.clone())
+                    .map(|i| self.node_transfer(source, i))
+                    .sum();
+                self.shafts[k].kind = Kind::Leaf;
+                self.shafts[k].child = self.leaf_transfer.len() as u32;
+                self.leaf_transfer.push(sum);
+                k += 1;
+                continue;
             }
+            let split_source =
+                !s.is_leaf() && (r.is_leaf() || self.source_size(source, &r) >= r.bounds.size().length());
+            let pairs: Vec<(u32, u32)> = if split_source {
+                self.source_tree.children(source).map(|c| (c, receiver)).collect()
+            } else {
+                self.receiver_tree.children(receiver).map(|c| (source, c)).collect()
+            };
+            let child = self.shafts.len() as u32;
+            let mut pruned = 0u8;
+            for (c, &(cs, cr)) in pairs.iter().enumerate() {
+                if self.negligible(cs, cr) {
+                    pruned |= 1 << c;
+                } else {
+                    self.shafts.push(ShaftNode {
+                        source: cs,
+                        receiver: cr,
+                        child: 0,
+                        children: 0,
+                        pruned: 0,
+                        kind: Kind::Leaf,
+                    });
+                }
+            }
+            let children = (self.shafts.len() as u32 - child) as u8;
+            let node = &mut self.shafts[k];
+            node.kind = if split_source { Kind::SplitSource } else { Kind::SplitReceiver };
+            node.child = child;
+            node.children = children;
+            node.pruned = pruned;
             k += 1;
+        }
+    }
+
+    /// The (source node, receiver node) pairs a split node's tree children make, in order.
+    fn child_pairs(&self, n: &ShaftNode) -> Vec<(u32, u32)> {
+        match n.kind {
+            Kind::SplitSource => self.source_tree.children(n.source).map(|c| (c, n.receiver)).collect(),
+            Kind::SplitReceiver => self.receiver_tree.children(n.receiver).map(|c| (n.source, c)).collect(),
+            Kind::Leaf => Vec::new(),
         }
     }
 
@@ -295,17 +351,18 @@ impl ShaftHierarchy {
     }
 
     /// How wide a source node's end of a shaft to `r` is.
-    fn source_size(&self, s: &Node, r: &Node) -> f32 {
+    fn source_size(&self, s: u32, r: &Node) -> f32 {
         self.source_box(s, &r.bounds).size().length()
     }
 
     /// A source node's end of the shaft to receiver box `r`: its local sources' box, and for its
     /// distant sources the proxy box `r ⊕ reach · directions`, which holds every segment's far
     /// end.
-    fn source_box(&self, s: &Node, r: &Aabb) -> Aabb {
-        let mut b = s.bounds;
-        if !s.directions.is_empty() {
-            let proxy = Aabb { min: r.min + s.directions.min * self.reach, max: r.max + s.directions.max * self.reach };
+    fn source_box(&self, s: u32, r: &Aabb) -> Aabb {
+        let mut b = self.source_tree.nodes[s as usize].bounds;
+        let dirs = self.source_tree.directions(s);
+        if !dirs.is_empty() {
+            let proxy = Aabb { min: r.min + dirs.min * self.reach, max: r.max + dirs.max * self.reach };
             b = b.union(&proxy);
         }
         b
@@ -315,8 +372,14 @@ impl ShaftHierarchy {
     #[must_use]
     pub fn shaft(&self, k: u32) -> Shaft {
         let n = self.shafts[k as usize];
-        let r = self.receiver_tree.nodes[n.receiver as usize].bounds;
-        Shaft::new(&self.source_box(&self.source_tree.nodes[n.source as usize], &r), &r)
+        let (a, b) = self.ends(n.source, n.receiver);
+        Shaft::new(&a, &b)
+    }
+
+    /// The two boxes a (source node, receiver node) pair's shaft joins.
+    fn ends(&self, source: u32, receiver: u32) -> (Aabb, Aabb) {
+        let r = self.receiver_tree.nodes[receiver as usize].bounds;
+        (self.source_box(source, &r), r)
     }
 
     /// How far distant sources' shafts reach.
@@ -334,7 +397,13 @@ impl ShaftHierarchy {
     /// Number of leaf shafts (kept pairs).
     #[must_use]
     pub fn leaf_shafts(&self) -> usize {
-        self.shafts.iter().filter(|s| s.kind == Kind::Leaf).count()
+        self.leaf_transfer.len()
+    }
+
+    /// Number of pruned pairs (not stored as nodes).
+    #[must_use]
+    pub fn pruned_pairs(&self) -> usize {
+        self.shafts.iter().map(|s| s.pruned.count_ones() as usize).sum::<usize>() + usize::from(self.root_pruned)
     }
 
     /// Bytes the hierarchy needs at traversal: shaft nodes, tree nodes and permutations (the
@@ -343,7 +412,9 @@ impl ShaftHierarchy {
     pub fn bytes(&self) -> usize {
         use std::mem::size_of;
         self.shafts.len() * size_of::<ShaftNode>()
+            + self.leaf_transfer.len() * size_of::<f32>()
             + (self.source_tree.nodes.len() + self.receiver_tree.nodes.len()) * size_of::<Node>()
+            + (self.source_tree.directions.len() + self.receiver_tree.directions.len()) * size_of::<Aabb>()
             + (self.source_tree.order.len() + self.receiver_tree.order.len()) * size_of::<u32>()
     }
 
@@ -378,39 +449,77 @@ impl ShaftHierarchy {
             .validate(self.receivers.len(), |i| (self.receivers[i as usize].bounds, Aabb::EMPTY))
             .map_err(|e| format!("receiver tree: {e}"))?;
         let mut reached = vec![0.0f64; self.slots];
+        let mut reach_pair = |source: u32, receiver: u32| {
+            for &p in self.receiver_tree.items(receiver) {
+                for i in self.receivers[p as usize].slots.clone() {
+                    reached[i as usize] += f64::from(self.node_transfer(source, i));
+                }
+            }
+        };
+        if self.root_pruned {
+            if !self.shafts.is_empty() {
+                return Err("a pruned root with shafts".into());
+            }
+            reach_pair(0, 0);
+        }
+        let mut leaves = 0;
         for (k, n) in self.shafts.iter().enumerate() {
             let (s, r) = (self.source_tree.nodes[n.source as usize], self.receiver_tree.nodes[n.receiver as usize]);
             let shaft = self.shaft(k as u32);
-            let ends = [self.source_box(&s, &r.bounds), r.bounds];
-            if ends.iter().any(|b| !b.is_empty() && !(0..8).all(|c| shaft.contains_point(b.corner(c)))) {
+            let (a, b) = self.ends(n.source, n.receiver);
+            if [a, b].iter().any(|bx| !bx.is_empty() && !(0..8).all(|c| shaft.contains_point(bx.corner(c)))) {
                 return Err(format!("shaft {k} does not hold its boxes"));
             }
-            match n.kind {
-                Kind::Inner => {
-                    let kids = &self.shafts[n.child as usize..(n.child + u32::from(n.children)) as usize];
-                    let by_source: Vec<u32> = self.source_tree.children(n.source).collect();
-                    let by_receiver: Vec<u32> = self.receiver_tree.children(n.receiver).collect();
-                    let split_s = kids.iter().map(|c| c.source).collect::<Vec<_>>() == by_source
-                        && kids.iter().all(|c| c.receiver == n.receiver);
-                    let split_r = kids.iter().map(|c| c.receiver).collect::<Vec<_>>() == by_receiver
-                        && kids.iter().all(|c| c.source == n.source);
-                    if kids.is_empty() || !(split_s || split_r) || n.child as usize <= k {
-                        return Err(format!("shaft {k}: children do not split one of its nodes"));
-                    }
-                }
-                Kind::Leaf if !(s.is_leaf() && r.is_leaf()) => {
+            if n.kind == Kind::Leaf {
+                if !(s.is_leaf() && r.is_leaf()) {
                     return Err(format!("leaf shaft {k} joins an inner node"));
                 }
-                Kind::Leaf | Kind::Pruned => {
-                    for &p in self.receiver_tree.items(n.receiver) {
-                        for i in self.receivers[p as usize].slots.clone() {
-                            reached[i as usize] += f64::from(self.node_transfer(n.source, i));
-                        }
+                if n.child as usize != leaves {
+                    return Err(format!("leaf shaft {k}: transfer index {} out of order", n.child));
+                }
+                let sum: f64 = self
+                    .receiver_tree
+                    .items(n.receiver)
+                    .iter()
+                    .flat_map(|&p| self.receivers[p as usize].slots.clone())
+                    .map(|i| f64::from(self.node_transfer(n.source, i)))
+                    .sum();
+                let stored = f64::from(self.leaf_transfer[leaves]);
+                if (sum - stored).abs() > 1e-4 * sum.abs().max(1e-30) {
+                    return Err(format!("leaf shaft {k}: stored transfer {stored}, summed {sum}"));
+                }
+                leaves += 1;
+                reach_pair(n.source, n.receiver);
+                continue;
+            }
+            let pairs = self.child_pairs(n);
+            if pairs.is_empty() || n.child as usize <= k || pairs.len() > 8 {
+                return Err(format!("shaft {k}: splits a leaf, or its children come first"));
+            }
+            let mut stored = n.child as usize;
+            for (c, &(cs, cr)) in pairs.iter().enumerate() {
+                if n.pruned & (1 << c) != 0 {
+                    reach_pair(cs, cr);
+                } else {
+                    let kid = self.shafts.get(stored).ok_or_else(|| format!("shaft {k}: child {stored} missing"))?;
+                    if (kid.source, kid.receiver) != (cs, cr) {
+                        return Err(format!("shaft {k}: children do not split one of its nodes"));
                     }
+                    stored += 1;
                 }
             }
+            if stored - n.child as usize != usize::from(n.children) {
+                return Err(format!(
+                    "shaft {k}: {} children stored, {} expected",
+                    n.children,
+                    stored - n.child as usize
+                ));
+            }
         }
-        if !self.shafts.is_empty() {
+        if leaves != self.leaf_transfer.len() {
+            return Err(format!("{leaves} leaf shafts, {} leaf transfers", self.leaf_transfer.len()));
+        }
+        if !self.shafts.is_empty() || self.root_pruned {
             for p in &self.receivers {
                 for i in p.slots.clone() {
                     let total = f64::from(self.node_transfer(0, i));
@@ -427,15 +536,26 @@ impl ShaftHierarchy {
     }
 
     /// The shafts `object` meets: the sources it may occlude and the receivers it may darken,
-    /// each once. A shaft wholly inside the object's box (so are its children's) is descended
-    /// without further tests.
+    /// each once. A shaft inside the object's box (and so every shaft below it) is descended
+    /// without further tests; the pruned children of a shaft it meets are listed untested.
     pub fn traverse(&self, object: &Aabb, scratch: &mut Traversal, out: &mut Occlusion) {
         out.sources.clear();
         out.receivers.clear();
         out.leaf_shafts.clear();
-        out.pruned_shafts.clear();
+        out.pruned.clear();
         out.tested = 0;
-        if self.shafts.is_empty() || object.is_empty() {
+        if object.is_empty() {
+            return;
+        }
+        if self.root_pruned {
+            let (a, b) = self.ends(0, 0);
+            out.tested = 1;
+            if meets(&a, &b, object) != Meet::Outside {
+                out.pruned.push((0, 0));
+            }
+            return;
+        }
+        if self.shafts.is_empty() {
             return;
         }
         scratch.frame = scratch.frame.wrapping_add(1);
@@ -452,88 +572,83 @@ impl ShaftHierarchy {
         scratch.stack.push((0, false));
         while let Some((k, inside)) = scratch.stack.pop() {
             let n = self.shafts[k as usize];
-            // a shaft inside the object's box holds its children's shafts: all reported untested
             let inside = inside || {
                 out.tested += 1;
-                let shaft = self.shaft(k);
-                if object.contains(&shaft.extent) {
-                    true
-                } else if shaft.classify(object) == Overlap::Outside {
-                    continue;
-                } else {
-                    false
+                let (a, b) = self.ends(n.source, n.receiver);
+                match meets(&a, &b, object) {
+                    Meet::Outside => continue,
+                    Meet::Partial => false,
+                    Meet::Covers => true,
                 }
             };
-            match n.kind {
-                Kind::Inner => {
-                    scratch.stack.extend((n.child..n.child + u32::from(n.children)).rev().map(|c| (c, inside)))
+            if n.kind == Kind::Leaf {
+                out.leaf_shafts.push(k);
+                for &j in self.source_tree.items(n.source) {
+                    if scratch.source_tag[j as usize] != frame {
+                        scratch.source_tag[j as usize] = frame;
+                        out.sources.push(j);
+                    }
                 }
-                Kind::Pruned => out.pruned_shafts.push(k),
-                Kind::Leaf => {
-                    out.leaf_shafts.push(k);
-                    for &j in self.source_tree.items(n.source) {
-                        if scratch.source_tag[j as usize] != frame {
-                            scratch.source_tag[j as usize] = frame;
-                            out.sources.push(j);
-                        }
+                for &p in self.receiver_tree.items(n.receiver) {
+                    if scratch.receiver_tag[p as usize] != frame {
+                        scratch.receiver_tag[p as usize] = frame;
+                        out.receivers.push(p);
                     }
-                    for &p in self.receiver_tree.items(n.receiver) {
-                        if scratch.receiver_tag[p as usize] != frame {
-                            scratch.receiver_tag[p as usize] = frame;
-                            out.receivers.push(p);
-                        }
-                    }
+                }
+                continue;
+            }
+            let mut stored = n.child;
+            let split = if n.kind == Kind::SplitSource { n.source } else { n.receiver };
+            let tree = if n.kind == Kind::SplitSource { &self.source_tree } else { &self.receiver_tree };
+            for (c, child) in tree.children(split).enumerate() {
+                if n.pruned & (1 << c) != 0 {
+                    out.pruned.push(if n.kind == Kind::SplitSource { (child, n.receiver) } else { (n.source, child) });
+                } else {
+                    scratch.stack.push((stored, inside));
+                    stored += 1;
                 }
             }
         }
     }
 
     /// Paper 003's representative set: `n` source-tree nodes standing for every source in
-    /// `occlusion`. From the root, repeatedly open the node whose occluded sources send the
-    /// most (on average over the frame's receiver vertices) until `n` nodes are listed or all
-    /// are single sources. Each keeps the summed transfer of the occluded sources under it, so
-    /// the set accounts for all of them whatever `n` (0 reads as 1).
+    /// `occlusion` (0 reads as 1). From the root, repeatedly open the node whose occluded
+    /// sources send the most (their transfer through the met leaf shafts) until `n` nodes are
+    /// listed or all are single sources. Each keeps the summed transfer of the occluded
+    /// sources under it, so the set accounts for all of them whatever `n`.
     #[must_use]
     pub fn representatives(&self, occlusion: &Occlusion, n: usize) -> Vec<Representative> {
         if occlusion.sources.is_empty() || self.source_tree.nodes.is_empty() {
             return Vec::new();
         }
-        let vertices: Vec<u32> =
-            occlusion.receivers.iter().flat_map(|&p| self.receivers[p as usize].slots.clone()).collect();
-        // each occluded source's transfer to the frame's vertices, summed up the tree
         let nodes = &self.source_tree.nodes;
+        // each occluded source's transfer through the met leaf shafts, summed up the tree
         let mut sum = vec![0.0f64; nodes.len()];
         let mut best = vec![(f64::NEG_INFINITY, u32::MAX); nodes.len()];
         let mut count = vec![0u32; nodes.len()];
-        let mut occluded = vec![false; self.sources.len()];
+        for &k in &occlusion.leaf_shafts {
+            let s = self.shafts[k as usize];
+            sum[s.source as usize] += f64::from(self.leaf_transfer[s.child as usize]);
+        }
         for &j in &occlusion.sources {
-            occluded[j as usize] = true;
+            let leaf = self.source_leaf[j as usize] as usize;
+            count[leaf] = 1;
+            best[leaf] = (sum[leaf], j);
         }
         for k in (0..nodes.len()).rev() {
             if nodes[k].is_leaf() {
-                for &j in self.source_tree.items(k as u32) {
-                    if occluded[j as usize] {
-                        let t: f64 = vertices.iter().map(|&i| f64::from(self.node_transfer(k as u32, i))).sum();
-                        sum[k] += t;
-                        count[k] += 1;
-                        if t > best[k].0 {
-                            best[k] = (t, j);
-                        }
-                    }
-                }
-            } else {
-                for c in self.source_tree.children(k as u32) {
-                    let c = c as usize;
-                    sum[k] += sum[c];
-                    count[k] += count[c];
-                    if best[c].0 > best[k].0 {
-                        best[k] = best[c];
-                    }
+                continue;
+            }
+            for c in self.source_tree.children(k as u32) {
+                let c = c as usize;
+                sum[k] += sum[c];
+                count[k] += count[c];
+                if count[c] > 0 && best[c].0 > best[k].0 {
+                    best[k] = best[c];
                 }
             }
         }
-        let per_vertex = 1.0 / vertices.len().max(1) as f64;
-        let key = |k: usize| Open { average: sum[k] * per_vertex, node: k as u32 };
+        let key = |k: usize| Open { transfer: sum[k], node: k as u32 };
         let mut open = BinaryHeap::from([key(0)]);
         let mut done = Vec::new();
         while let Some(top) = open.pop() {
@@ -554,10 +669,10 @@ impl ShaftHierarchy {
     }
 }
 
-/// A representative-set candidate, ordered by average transfer.
+/// A representative-set candidate, ordered by transfer.
 #[derive(PartialEq)]
 struct Open {
-    average: f64,
+    transfer: f64,
     node: u32,
 }
 
@@ -571,6 +686,6 @@ impl PartialOrd for Open {
 
 impl Ord for Open {
     fn cmp(&self, other: &Self) -> std::cmp::Ordering {
-        self.average.total_cmp(&other.average).then_with(|| other.node.cmp(&self.node))
+        self.transfer.total_cmp(&other.transfer).then_with(|| other.node.cmp(&self.node))
     }
 }

@@ -1,11 +1,23 @@
 //! Decides, fast, which light sources a moving synthetic object can occlude for which receivers:
 //! source and receiver patch hierarchies and a shaft hierarchy over line space (paper 003).
 //!
-//! Built so far: the shaft between two boxes ([`Shaft`]: Haines and Wallace's joint box and
-//! joining planes, exactly the boxes' convex hull) and its conservative box test.
+//! - [`Shaft`]: Haines and Wallace's joint box and joining planes between two boxes (exactly
+//!   their convex hull), and its conservative box test.
+//! - [`source_tree`] (binary KD-tree, one source a leaf) and [`receiver_octree`].
+//! - [`ShaftHierarchy`]: built from the root pair by splitting the larger node, pruning pairs
+//!   below 2 % of every reached vertex's radiance; per frame, [`ShaftHierarchy::traverse`] and
+//!   [`ShaftHierarchy::representatives`]; [`ShaftHierarchy::validate`] checks its invariants.
+//! - [`preprocess`]: the source set, receivers and transfers of a `real_scene::RealScene`.
+//! - [`measure`]: the object path, the brute-force conservativeness check, timing, overlay.
+//!
+//! Distant sources (the lights of an environment map) have no position: their end of a shaft
+//! is the receiver box moved `reach` along the light's cone of directions, so objects further
+//! than `reach` along a light are not found.
 
 mod aabb;
 mod hierarchy;
+pub mod measure;
+pub mod preprocess;
 mod shaft;
 mod tree;
 
@@ -13,5 +25,5 @@ pub use aabb::Aabb;
 pub use hierarchy::{
     BuildError, Kind, Occlusion, Receiver, Representative, Settings, ShaftHierarchy, ShaftNode, Transfers, Traversal,
 };
-pub use shaft::{Overlap, Plane, Shaft};
+pub use shaft::{Meet, Overlap, Plane, Shaft, meets};
 pub use tree::{Node, SourceShape, Tree, cone_directions, receiver_octree, source_tree};

@@ -43,6 +43,118 @@ enum Owner {
     Both,
 }
 
+/// The edges of the joint box whose two faces come from different boxes: per edge, its two
+/// axes (i, j), the matching edge of `a` and of `b`, and the joint box's corner, all in (i, j).
+fn joining_edges(a: &Aabb, b: &Aabb) -> impl Iterator<Item = (usize, usize, [f32; 2], [f32; 2], [f32; 2])> {
+    let (a, b) = (*a, *b);
+    let extent = a.union(&b);
+    let owner = move |axis: usize, max: bool| {
+        let (x, y) = if max { (a.max[axis], b.max[axis]) } else { (a.min[axis], b.min[axis]) };
+        match x.partial_cmp(&y) {
+            Some(std::cmp::Ordering::Greater) => {
+                if max {
+                    Owner::A
+                } else {
+                    Owner::B
+                }
+            }
+            Some(std::cmp::Ordering::Less) => {
+                if max {
+                    Owner::B
+                } else {
+                    Owner::A
+                }
+            }
+            _ => Owner::Both,
+        }
+    };
+    let side = |bx: &Aabb, axis: usize, max: bool| if max { bx.max[axis] } else { bx.min[axis] };
+    [(0, 1), (1, 2), (2, 0)].into_iter().flat_map(move |(i, j)| {
+        [(false, false), (false, true), (true, false), (true, true)].into_iter().filter_map(move |(max_i, max_j)| {
+            let (oi, oj) = (owner(i, max_i), owner(j, max_j));
+            (oi != oj && oi != Owner::Both && oj != Owner::Both).then(|| {
+                (
+                    i,
+                    j,
+                    [side(&a, i, max_i), side(&a, j, max_j)],
+                    [side(&b, i, max_i), side(&b, j, max_j)],
+                    [side(&extent, i, max_i), side(&extent, j, max_j)],
+                )
+            })
+        })
+    })
+}
+
+/// How an object's box meets a shaft, as [`meets`] answers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Meet {
+    /// No point in common.
+    Outside,
+    /// Possibly in common.
+    Partial,
+    /// The object's box holds the whole shaft (and so every shaft inside it).
+    Covers,
+}
+
+/// How `object` meets the shaft between `a` and `b`, without building it: the joint box first,
+/// then each joining plane as it is found, stopping at the first that rejects. Conservative as
+/// [`Shaft::classify`]; what traversal uses, as it stores no planes.
+#[must_use]
+pub fn meets(a: &Aabb, b: &Aabb, object: &Aabb) -> Meet {
+    let extent = a.union(b);
+    if !extent.overlaps(object) {
+        return Meet::Outside;
+    }
+    if object.contains(&extent) {
+        return Meet::Covers;
+    }
+    // which box defines each face of the joint box: +1 a, -1 b, 0 both
+    let owner = |x: f32, y: f32, max: bool| -> i8 {
+        if x == y {
+            0
+        } else if (x > y) == max {
+            1
+        } else {
+            -1
+        }
+    };
+    let mut lo = [0i8; 3];
+    let mut hi = [0i8; 3];
+    for k in 0..3 {
+        lo[k] = owner(a.min[k], b.min[k], false);
+        hi[k] = owner(a.max[k], b.max[k], true);
+    }
+    for (i, j) in [(0usize, 1usize), (1, 2), (2, 0)] {
+        for (max_i, max_j) in [(false, false), (false, true), (true, false), (true, true)] {
+            let oi = if max_i { hi[i] } else { lo[i] };
+            let oj = if max_j { hi[j] } else { lo[j] };
+            if oi == 0 || oj == 0 || oi == oj {
+                continue;
+            }
+            let pick = |bx: &Aabb, k: usize, max: bool| if max { bx.max[k] } else { bx.min[k] };
+            let pa = [pick(a, i, max_i), pick(a, j, max_j)];
+            let pb = [pick(b, i, max_i), pick(b, j, max_j)];
+            let corner = [pick(&extent, i, max_i), pick(&extent, j, max_j)];
+            let mut n = [pb[1] - pa[1], pa[0] - pb[0]];
+            if n[0] * (corner[0] - pa[0]) + n[1] * (corner[1] - pa[1]) < 0.0 {
+                n = [-n[0], -n[1]];
+            }
+            let near = [
+                if n[0] > 0.0 { object.min[i] } else { object.max[i] },
+                if n[1] > 0.0 { object.min[j] } else { object.max[j] },
+            ];
+            let offset = (n[0] * pa[0] + n[1] * pa[1]).max(n[0] * pb[0] + n[1] * pb[1]);
+            // f32 rounding of every product here: outward by more than it can be
+            let scale = n[0].abs() * pa[0].abs().max(pb[0].abs()).max(near[0].abs())
+                + n[1].abs() * pa[1].abs().max(pb[1].abs()).max(near[1].abs());
+            if n[0] * near[0] + n[1] * near[1] > offset + 16.0 * f32::EPSILON * scale {
+                return Meet::Outside;
+            }
+        }
+    }
+    Meet::Partial
+}
+
 impl Shaft {
     /// The shaft between `a` and `b` (either may be flat; both must be non-empty).
     ///
@@ -52,57 +164,27 @@ impl Shaft {
     #[must_use]
     pub fn new(a: &Aabb, b: &Aabb) -> Self {
         let extent = a.union(b);
-        let owner = |axis: usize, max: bool| {
-            let (x, y) = if max { (a.max[axis], b.max[axis]) } else { (a.min[axis], b.min[axis]) };
-            match (x - y).partial_cmp(&0.0) {
-                Some(std::cmp::Ordering::Equal) | None => Owner::Both,
-                Some(std::cmp::Ordering::Greater) => {
-                    if max {
-                        Owner::A
-                    } else {
-                        Owner::B
-                    }
-                }
-                Some(std::cmp::Ordering::Less) => {
-                    if max {
-                        Owner::B
-                    } else {
-                        Owner::A
-                    }
-                }
-            }
-        };
-        let side = |bx: &Aabb, axis: usize, max: bool| if max { bx.max[axis] } else { bx.min[axis] };
         let mut shaft = Self { extent, planes: [Plane { normal: Vec3::ZERO, offset: 0.0 }; 8], count: 0 };
-        for (i, j) in [(0, 1), (1, 2), (2, 0)] {
-            for (max_i, max_j) in [(false, false), (false, true), (true, false), (true, true)] {
-                let (oi, oj) = (owner(i, max_i), owner(j, max_j));
-                if oi == oj || oi == Owner::Both || oj == Owner::Both {
-                    continue;
-                }
-                // in the (i, j) plane: the edge of `a` and the edge of `b` at this corner
-                let pa = [f64::from(side(a, i, max_i)), f64::from(side(a, j, max_j))];
-                let pb = [f64::from(side(b, i, max_i)), f64::from(side(b, j, max_j))];
-                let d = [pb[0] - pa[0], pb[1] - pa[1]];
-                let mut n = [d[1], -d[0]];
-                // outward: towards the joint box's corner, which the plane cuts off
-                let corner = [f64::from(side(&extent, i, max_i)), f64::from(side(&extent, j, max_j))];
-                if n[0] * (corner[0] - pa[0]) + n[1] * (corner[1] - pa[1]) < 0.0 {
-                    n = [-n[0], -n[1]];
-                }
-                let len = n[0].hypot(n[1]);
-                let n = [n[0] / len, n[1] / len];
-                let offset = (n[0] * pa[0] + n[1] * pa[1]).max(n[0] * pb[0] + n[1] * pb[1]);
-                // f32 evaluation of n·x errs by a few ulps of |n_i x_i|: round outward by more
-                let scale =
-                    (n[0] * pa[0]).abs().max((n[1] * pa[1]).abs()).max((n[0] * pb[0]).abs()).max((n[1] * pb[1]).abs());
-                let offset = offset + scale * 8.0 * f64::from(f32::EPSILON);
-                let mut normal = Vec3::ZERO;
-                normal[i] = n[0] as f32;
-                normal[j] = n[1] as f32;
-                shaft.planes[usize::from(shaft.count)] = Plane { normal, offset: offset as f32 };
-                shaft.count += 1;
+        for (i, j, pa, pb, corner) in joining_edges(a, b) {
+            let (pa, pb, corner) = (pa.map(f64::from), pb.map(f64::from), corner.map(f64::from));
+            let d = [pb[0] - pa[0], pb[1] - pa[1]];
+            let mut n = [d[1], -d[0]];
+            // outward: towards the joint box's corner, which the plane cuts off
+            if n[0] * (corner[0] - pa[0]) + n[1] * (corner[1] - pa[1]) < 0.0 {
+                n = [-n[0], -n[1]];
             }
+            let len = n[0].hypot(n[1]);
+            let n = [n[0] / len, n[1] / len];
+            let offset = (n[0] * pa[0] + n[1] * pa[1]).max(n[0] * pb[0] + n[1] * pb[1]);
+            // f32 evaluation of n·x errs by a few ulps of |n_i x_i|: round outward by more
+            let scale =
+                (n[0] * pa[0]).abs().max((n[1] * pa[1]).abs()).max((n[0] * pb[0]).abs()).max((n[1] * pb[1]).abs());
+            let offset = offset + scale * 8.0 * f64::from(f32::EPSILON);
+            let mut normal = Vec3::ZERO;
+            normal[i] = n[0] as f32;
+            normal[j] = n[1] as f32;
+            shaft.planes[usize::from(shaft.count)] = Plane { normal, offset: offset as f32 };
+            shaft.count += 1;
         }
         shaft
     }
@@ -258,6 +340,31 @@ mod tests {
     /// `Outside` is never wrong: no segment from a point of A to a point of B meets a box the
     /// shaft rejects (random segments, and all 64 corner pairs), and `Inside` boxes lie in the
     /// hull.
+    /// The lazy test agrees with the built shaft: never `Outside` for a box a segment meets,
+    /// `Covers` only for boxes holding the joint box, and the same verdict nearly always.
+    #[test]
+    fn meets_agrees_with_classify() {
+        let mut rng = Pcg64::seed_from_u64(4);
+        let mut differ = 0;
+        for _ in 0..20_000 {
+            let (a, b, c) = (random_box(&mut rng, 1.0), random_box(&mut rng, 1.0), random_box(&mut rng, 1.0));
+            let fast = meets(&a, &b, &c);
+            let slow = Shaft::new(&a, &b).classify(&c);
+            if fast == Meet::Covers {
+                assert!(c.contains(&a.union(&b)));
+            }
+            if (fast == Meet::Outside) != (slow == Overlap::Outside) {
+                differ += 1;
+            }
+            if fast == Meet::Outside {
+                for k in 0..64 {
+                    assert!(!c.segment_hits(a.corner(k % 8), b.corner(k / 8)), "{a:?} {b:?} {c:?}");
+                }
+            }
+        }
+        assert!(differ < 20, "{differ} verdicts differ");
+    }
+
     #[test]
     fn classify_is_conservative() {
         let mut rng = Pcg64::seed_from_u64(3);

@@ -22,8 +22,6 @@ pub enum SourceShape {
 pub struct Node {
     /// Bounds of the node's local items (`Aabb::EMPTY` when it has none).
     pub bounds: Aabb,
-    /// Bounds of its distant sources' directions (`Aabb::EMPTY` when none; receivers: always).
-    pub directions: Aabb,
     /// Its items: `order[first..first + count]`.
     pub first: u32,
     /// Number of items.
@@ -49,6 +47,9 @@ pub struct Tree {
     pub nodes: Vec<Node>,
     /// Item indices, grouped so that each node's items are one range.
     pub order: Vec<u32>,
+    /// Per node, the bounds of its distant sources' unit directions (`Aabb::EMPTY` for none);
+    /// empty when no item is distant (receivers, local-only sources).
+    pub directions: Vec<Aabb>,
 }
 
 impl Tree {
@@ -57,6 +58,12 @@ impl Tree {
     pub fn items(&self, node: u32) -> &[u32] {
         let n = &self.nodes[node as usize];
         &self.order[n.first as usize..(n.first + n.count) as usize]
+    }
+
+    /// The bounds of `node`'s distant directions (`Aabb::EMPTY` when none).
+    #[must_use]
+    pub fn directions(&self, node: u32) -> Aabb {
+        self.directions.get(node as usize).copied().unwrap_or(Aabb::EMPTY)
     }
 
     /// The children of `node`.
@@ -88,7 +95,8 @@ impl Tree {
         for (k, n) in self.nodes.iter().enumerate() {
             for &i in self.items(k as u32) {
                 let (b, d) = shape(i);
-                if !(b.is_empty() || n.bounds.contains(&b)) || !(d.is_empty() || n.directions.contains(&d)) {
+                let dirs = self.directions(k as u32);
+                if !(b.is_empty() || n.bounds.contains(&b)) || !(d.is_empty() || dirs.contains(&d)) {
                     return Err(format!("node {k} does not bound item {i}"));
                 }
             }
@@ -118,7 +126,7 @@ impl Tree {
 /// along the widest axis of the centres (positions, or directions), down to one source a leaf.
 #[must_use]
 pub fn source_tree(sources: &[SourceShape]) -> Tree {
-    let mut tree = Tree { nodes: Vec::new(), order: (0..sources.len() as u32).collect() };
+    let mut tree = Tree { nodes: Vec::new(), order: (0..sources.len() as u32).collect(), directions: Vec::new() };
     if sources.is_empty() {
         return tree;
     }
@@ -128,7 +136,15 @@ pub fn source_tree(sources: &[SourceShape]) -> Tree {
     let centre = |i: u32| match sources[i as usize] {
         SourceShape::Local(b) | SourceShape::Distant(b) => b.center(),
     };
-    tree.nodes.push(source_node(sources, &tree.order, 0, sources.len()));
+    let distant = sources.len() - locals;
+    let push = |tree: &mut Tree, first: usize, count: usize| {
+        let (node, dirs) = source_node(sources, &tree.order, first, count);
+        tree.nodes.push(node);
+        if distant > 0 {
+            tree.directions.push(dirs);
+        }
+    };
+    push(&mut tree, 0, sources.len());
     let mut stack = vec![0u32];
     while let Some(k) = stack.pop() {
         let n = tree.nodes[k as usize];
@@ -147,8 +163,8 @@ pub fn source_tree(sources: &[SourceShape]) -> Tree {
             first + half
         };
         let child = tree.nodes.len() as u32;
-        tree.nodes.push(source_node(sources, &tree.order, first, mid - first));
-        tree.nodes.push(source_node(sources, &tree.order, mid, first + count - mid));
+        push(&mut tree, first, mid - first);
+        push(&mut tree, mid, first + count - mid);
         let node = &mut tree.nodes[k as usize];
         node.child = child;
         node.children = 2;
@@ -157,7 +173,7 @@ pub fn source_tree(sources: &[SourceShape]) -> Tree {
     tree
 }
 
-fn source_node(sources: &[SourceShape], order: &[u32], first: usize, count: usize) -> Node {
+fn source_node(sources: &[SourceShape], order: &[u32], first: usize, count: usize) -> (Node, Aabb) {
     let (mut bounds, mut directions) = (Aabb::EMPTY, Aabb::EMPTY);
     for &i in &order[first..first + count] {
         match sources[i as usize] {
@@ -165,7 +181,7 @@ fn source_node(sources: &[SourceShape], order: &[u32], first: usize, count: usiz
             SourceShape::Distant(d) => directions = directions.union(&d),
         }
     }
-    Node { bounds, directions, first: first as u32, count: count as u32, child: 0, children: 0 }
+    (Node { bounds, first: first as u32, count: count as u32, child: 0, children: 0 }, directions)
 }
 
 /// The octree over receiver patches (their boxes): a node splits at its centre into up to 8
@@ -174,13 +190,12 @@ fn source_node(sources: &[SourceShape], order: &[u32], first: usize, count: usiz
 #[must_use]
 pub fn receiver_octree(receivers: &[Aabb], leaf_size: usize) -> Tree {
     let leaf_size = leaf_size.max(1);
-    let mut tree = Tree { nodes: Vec::new(), order: (0..receivers.len() as u32).collect() };
+    let mut tree = Tree { nodes: Vec::new(), order: (0..receivers.len() as u32).collect(), directions: Vec::new() };
     if receivers.is_empty() {
         return tree;
     }
     let node = |order: &[u32], first: usize, count: usize| Node {
         bounds: order[first..first + count].iter().fold(Aabb::EMPTY, |b, &i| b.union(&receivers[i as usize])),
-        directions: Aabb::EMPTY,
         first: first as u32,
         count: count as u32,
         child: 0,

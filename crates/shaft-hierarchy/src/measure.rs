@@ -1,0 +1,215 @@
+//! What `cargo xtask shafts` and the bench measure: a built-in object path, the
+//! conservativeness check by brute-force segments, per-frame timing, and an overlay image.
+
+use std::collections::HashSet;
+use std::time::Instant;
+
+use glam::{Vec2, Vec3};
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64;
+use real_scene::{RealScene, Visibility, luminance};
+use scene::DistantLight;
+
+use crate::preprocess::{Prepared, Source};
+use crate::{Aabb, Occlusion, ShaftHierarchy, Traversal};
+
+/// A box a tenth of the scene's width flying a loop through it, `frames` positions: around
+/// the scene's centre at 35 % of its width and depth, bobbing between 5 % and 55 % of its
+/// height.
+#[must_use]
+pub fn object_path(scene: &RealScene, frames: usize) -> Vec<Aabb> {
+    let (lo, hi) = scene.bounds();
+    let size = hi - lo;
+    let centre = (lo + hi) * 0.5;
+    let half = 0.05 * (size.x + size.z) * 0.5;
+    (0..frames)
+        .map(|k| {
+            let t = k as f32 / frames.max(1) as f32 * std::f32::consts::TAU;
+            let c = Vec3::new(
+                centre.x + 0.35 * size.x * t.cos(),
+                lo.y + size.y * (0.3 + 0.25 * (3.0 * t).sin()),
+                centre.z + 0.35 * size.z * t.sin(),
+            );
+            Aabb::new(c - Vec3::splat(half), c + Vec3::splat(half))
+        })
+        .collect()
+}
+
+/// The brute-force check of a hierarchy against its objects.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Check {
+    /// Segments drawn, source point to receiver point.
+    pub segments: usize,
+    /// Those that meet the object's box.
+    pub hits: usize,
+    /// Hits in no reported leaf or pruned shaft: must be 0.
+    pub misses: usize,
+    /// Hits in a reported pruned shaft (below the threshold by design).
+    pub in_pruned: usize,
+    /// Sources with a hitting segment, summed over frames.
+    pub true_occluders: usize,
+    /// Of those, the ones the traversal reported.
+    pub found: usize,
+    /// Sources reported, summed over frames.
+    pub reported: usize,
+}
+
+/// A point of source `s` for a segment from receiver point `x` (a distant light's: `reach` along
+/// a direction in its cone).
+fn source_point(scene: &RealScene, lights: &[DistantLight], s: Source, x: Vec3, reach: f32, rng: &mut Pcg64) -> Vec3 {
+    match s {
+        Source::Patch(j) => scene.patches[j as usize].point(rng.random(), rng.random()),
+        Source::Distant(k) => x + lights[k as usize].sample_direction(Vec2::new(rng.random(), rng.random())).0 * reach,
+    }
+}
+
+/// For each object, `per_object` segments from a random point of a random source to a random
+/// point of a random receiver patch (fixed seed); a segment that meets the object's box must lie
+/// in a shaft the traversal reported.
+#[must_use]
+pub fn check(
+    h: &ShaftHierarchy,
+    prepared: &Prepared,
+    scene: &RealScene,
+    lights: &[DistantLight],
+    objects: &[Aabb],
+    per_object: usize,
+    seed: u64,
+) -> Check {
+    let mut rng = Pcg64::seed_from_u64(seed);
+    let mut scratch = Traversal::default();
+    let mut o = Occlusion::default();
+    let mut c = Check::default();
+    if prepared.sources.is_empty() || prepared.receivers.is_empty() {
+        return c;
+    }
+    for object in objects {
+        h.traverse(object, &mut scratch, &mut o);
+        let pairs = |nodes: &mut dyn Iterator<Item = (u32, u32)>| {
+            let mut set = HashSet::new();
+            for (source, receiver) in nodes {
+                for &j in h.source_tree.items(source) {
+                    for &p in h.receiver_tree.items(receiver) {
+                        set.insert((j, p));
+                    }
+                }
+            }
+            set
+        };
+        let kept =
+            pairs(&mut o.leaf_shafts.iter().map(|&k| (h.shafts[k as usize].source, h.shafts[k as usize].receiver)));
+        let pruned = pairs(&mut o.pruned.iter().copied());
+        let reported: HashSet<u32> = o.sources.iter().copied().collect();
+        let mut occluders = HashSet::new();
+        for _ in 0..per_object {
+            let j = rng.random_range(0..prepared.sources.len());
+            let r = rng.random_range(0..prepared.receivers.len());
+            let x = scene.patches[prepared.receivers[r] as usize].point(rng.random(), rng.random());
+            let y = source_point(scene, lights, prepared.sources[j], x, h.reach(), &mut rng);
+            c.segments += 1;
+            if !object.segment_hits(x, y) {
+                continue;
+            }
+            c.hits += 1;
+            occluders.insert(j as u32);
+            let pair = (j as u32, r as u32);
+            if kept.contains(&pair) {
+                continue;
+            }
+            if pruned.contains(&pair) {
+                c.in_pruned += 1;
+            } else {
+                c.misses += 1;
+            }
+        }
+        c.true_occluders += occluders.len();
+        c.found += occluders.iter().filter(|j| reported.contains(j)).count();
+        c.reported += o.sources.len();
+    }
+    c
+}
+
+/// Microseconds per frame of the traversal plus a representative set of `n`, for each object.
+#[must_use]
+pub fn frame_times(h: &ShaftHierarchy, objects: &[Aabb], n: usize) -> Vec<f64> {
+    let mut scratch = Traversal::default();
+    let mut o = Occlusion::default();
+    objects
+        .iter()
+        .map(|object| {
+            let t = Instant::now();
+            h.traverse(object, &mut scratch, &mut o);
+            let reps = h.representatives(&o, n);
+            std::hint::black_box(&reps);
+            t.elapsed().as_secs_f64() * 1e6
+        })
+        .collect()
+}
+
+/// The median of some values (0 for none).
+#[must_use]
+pub fn median(values: &[f64]) -> f64 {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    if v.is_empty() { 0.0 } else { v[v.len() / 2] }
+}
+
+/// An image of the scene from its camera (patch radiances, tone-mapped) with the receivers an
+/// object may darken tinted blue, the source patches it may occlude red, and the object's box
+/// yellow: 8-bit RGB, row-major, the camera's size.
+#[must_use]
+pub fn overlay(
+    scene: &RealScene,
+    vis: &impl Visibility,
+    prepared: &Prepared,
+    occlusion: &Occlusion,
+    object: &Aabb,
+) -> Vec<[u8; 3]> {
+    let mut receiver = vec![false; scene.patches.len()];
+    for &r in &occlusion.receivers {
+        receiver[prepared.receivers[r as usize] as usize] = true;
+    }
+    let mut source = vec![false; scene.patches.len()];
+    for &s in &occlusion.sources {
+        if let Source::Patch(j) = prepared.sources[s as usize] {
+            source[j as usize] = true;
+        }
+    }
+    let peak = {
+        let mut l: Vec<f32> = scene.patches.iter().map(|p| luminance(p.radiance)).collect();
+        l.sort_by(f32::total_cmp);
+        l.get(l.len() * 9 / 10).copied().unwrap_or(1.0).max(1e-6)
+    };
+    let rays = scene.camera.rays();
+    let mut out = Vec::with_capacity((scene.camera.width * scene.camera.height) as usize);
+    for y in 0..scene.camera.height {
+        for x in 0..scene.camera.width {
+            let (o, d) = rays.ray(x as f32 + 0.5, y as f32 + 0.5);
+            let hit = vis.first_hit(o, d);
+            let mut c = hit.map_or(Vec3::ZERO, |(p, _)| {
+                let l = scene.patches[p as usize].radiance / peak;
+                (l / (l + Vec3::ONE)).powf(1.0 / 2.2)
+            });
+            if let Some((p, t)) = hit {
+                if source[p as usize] {
+                    c = c.lerp(Vec3::new(1.0, 0.1, 0.1), 0.6);
+                } else if receiver[p as usize] {
+                    c = c.lerp(Vec3::new(0.2, 0.4, 1.0), 0.45);
+                }
+                if ray_box(o, d, object).is_some_and(|tb| tb < t) {
+                    c = c.lerp(Vec3::new(1.0, 0.85, 0.0), 0.75);
+                }
+            }
+            out.push((c.clamp(Vec3::ZERO, Vec3::ONE) * 255.0 + 0.5).to_array().map(|v| v as u8));
+        }
+    }
+    out
+}
+
+/// Entry distance of a ray into a box.
+fn ray_box(o: Vec3, d: Vec3, b: &Aabb) -> Option<f32> {
+    let inv = d.recip();
+    let (t0, t1) = ((b.min - o) * inv, (b.max - o) * inv);
+    let (near, far) = (t0.min(t1).max_element().max(0.0), t0.max(t1).min_element());
+    (near <= far).then_some(near)
+}

@@ -1,0 +1,153 @@
+//! `cargo xtask shafts`: paper 003's shaft hierarchy on a built-in real scene. Solves the
+//! scene's radiances (the stand-in for a capture), pre-processes (source set, receivers,
+//! transfers, trees, shafts), checks the hierarchy (validate and brute-force segments along a
+//! built-in object path), times a frame's traversal plus representative set, writes an overlay
+//! image, and prints the figures (one JSON object with `--json`).
+
+use std::path::Path;
+use std::time::Instant;
+
+use real_scene::{PatchBvh, RealScene, SolveSettings, Visibility};
+use shaft_hierarchy::measure::{check, frame_times, median, object_path, overlay};
+use shaft_hierarchy::preprocess::{PreprocessSettings, build};
+use shaft_hierarchy::{Occlusion, Traversal};
+
+/// Frames of the object path.
+const FRAMES: usize = 240;
+/// Segments drawn per frame by the conservativeness check (at least 100,000 in all).
+const SEGMENTS_PER_FRAME: usize = 500;
+/// Nodes of the representative set per frame.
+const REPRESENTATIVES: usize = 8;
+
+/// The command's options.
+pub struct ShaftsArgs<'a> {
+    pub scene: &'a str,
+    pub json: bool,
+    pub settings: PreprocessSettings,
+    pub out: &'a Path,
+}
+
+pub fn run(args: &ShaftsArgs) -> Result<(), String> {
+    let say = |s: &str| {
+        if !args.json {
+            outln!("{s}");
+        }
+    };
+    let mut scene = RealScene::builtin(args.scene).map_err(|e| e.to_string())?;
+    let t = Instant::now();
+    let bvh = PatchBvh::new(&scene);
+    // an environment-lit scene gets the embedded map, and its extracted lights as sources
+    let (map, lights) = if scene.environment_lit {
+        let map = envmap_sphere::default_map();
+        let d = light_extract::extractor(crate::validate::DEFAULT_METHOD, 32)
+            .ok_or("no default extractor")?
+            .extract(&map)
+            .map_err(|e| e.to_string())?;
+        let lights = d.distant_lights();
+        (Some(map), lights)
+    } else {
+        (None, Vec::new())
+    };
+    let report =
+        real_scene::solve(&mut scene, &bvh, map.as_ref(), &SolveSettings::default()).map_err(|e| e.to_string())?;
+    say(&format!(
+        "{}: {} patches, radiosity solved in {:.2} s ({} links, {} iterations){}",
+        scene.name,
+        scene.patches.len(),
+        t.elapsed().as_secs_f64(),
+        report.links,
+        report.iterations,
+        if lights.is_empty() {
+            String::new()
+        } else {
+            format!(", {} distant lights from the embedded map", lights.len())
+        }
+    ));
+    let t = Instant::now();
+    let (prepared, h) = build(&scene, &lights, &bvh, &args.settings).map_err(|e| e.to_string())?;
+    let preprocess_s = t.elapsed().as_secs_f64();
+    h.validate().map_err(|e| format!("the hierarchy is broken: {e}"))?;
+    let objects = object_path(&scene, FRAMES);
+    let c = check(&h, &prepared, &scene, &lights, &objects, SEGMENTS_PER_FRAME, 1);
+    // timing: the path three times, the median frame
+    let times: Vec<f64> = (0..3).flat_map(|_| frame_times(&h, &objects, REPRESENTATIVES)).collect();
+    let traversal_us = median(&times);
+    let bytes = h.bytes();
+    let leaf_shafts = h.leaf_shafts();
+    // the overlay at the path position nearest the middle of the view, among those in sight
+    let (right, up, forward) = scene.camera.basis();
+    let off_centre = |b: &shaft_hierarchy::Aabb| {
+        let d = b.center() - scene.camera.eye;
+        let z = d.dot(forward).max(1e-6);
+        (d.dot(right) / z).hypot(d.dot(up) / z)
+    };
+    let in_sight = |b: &&shaft_hierarchy::Aabb| bvh.clear(scene.camera.eye, b.center());
+    let nearest = |a: &&shaft_hierarchy::Aabb, b: &&shaft_hierarchy::Aabb| off_centre(a).total_cmp(&off_centre(b));
+    let shown = objects
+        .iter()
+        .filter(in_sight)
+        .min_by(nearest)
+        .or_else(|| objects.iter().min_by(nearest))
+        .ok_or("no object path")?;
+    let mut o = Occlusion::default();
+    h.traverse(shown, &mut Traversal::default(), &mut o);
+    let image = overlay(&scene, &bvh, &prepared, &o, shown);
+    std::fs::create_dir_all(args.out).map_err(|e| format!("{}: {e}", args.out.display()))?;
+    let png = args.out.join(format!("{}_overlay.png", scene.name));
+    let bytes_rgb: Vec<u8> = image.iter().flatten().copied().collect();
+    envmap_sphere::io::save_png_srgb8(&png, scene.camera.width, scene.camera.height, &bytes_rgb)
+        .map_err(|e| e.to_string())?;
+    if args.json {
+        let v = serde_json::json!({
+            "scene": scene.name,
+            "patches": scene.patches.len(),
+            "sources": prepared.sources.len(),
+            "receivers": prepared.receivers.len(),
+            "leaf_shafts": leaf_shafts,
+            "bytes": bytes,
+            "preprocess_s": preprocess_s,
+            "traversal_us": traversal_us,
+            "segments_checked": c.segments,
+            "misses": c.misses,
+            "segments_hitting": c.hits,
+            "hits_in_pruned_shafts": c.in_pruned,
+            "true_occluders_found": c.found as f64 / c.true_occluders.max(1) as f64,
+            "sources_reported_per_frame": c.reported as f64 / FRAMES as f64,
+            "shafts": h.shafts.len(),
+            "transfer_bytes": h.transfer_bytes(),
+            "source_power_share": prepared.power.0 / prepared.power.1.max(f64::MIN_POSITIVE),
+        });
+        outln!("{v}");
+    } else {
+        say(&format!(
+            "source set: {} sources ({:.0} % of the power), {} receivers ({} vertices)",
+            prepared.sources.len(),
+            100.0 * prepared.power.0 / prepared.power.1.max(f64::MIN_POSITIVE),
+            prepared.receivers.len(),
+            prepared.vertices.len()
+        ));
+        say(&format!(
+            "hierarchy: {} shafts, {leaf_shafts} leaf shafts, {bytes} bytes ({:.1} per leaf shaft; transfers {} bytes more), pre-processing {preprocess_s:.2} s",
+            h.shafts.len(),
+            bytes as f64 / leaf_shafts.max(1) as f64,
+            h.transfer_bytes()
+        ));
+        say(&format!(
+            "per frame ({FRAMES} positions of a box along a loop): traversal + {REPRESENTATIVES} representatives {traversal_us:.1} us (median), {:.1} sources reported",
+            c.reported as f64 / FRAMES as f64
+        ));
+        say(&format!(
+            "check: {} segments, {} meet the object, {} misses, {} in pruned shafts; {:.1} % of the true occluders found",
+            c.segments,
+            c.hits,
+            c.misses,
+            c.in_pruned,
+            100.0 * c.found as f64 / c.true_occluders.max(1) as f64
+        ));
+        say(&format!("wrote {}", png.display()));
+    }
+    if c.misses > 0 {
+        return Err(format!("{} occluded segments in no reported shaft", c.misses));
+    }
+    Ok(())
+}
