@@ -178,6 +178,10 @@ enum Command {
         /// Output folder of the overlay image.
         #[arg(long, default_value = "target/shafts")]
         out: PathBuf,
+        /// Instead, sweep the knobs one at a time (source share, leaf size, pruning) and print
+        /// a row each: time, memory and the fraction of true occluders found.
+        #[arg(long)]
+        sweep: bool,
     },
     /// Print an environment map's size, format, luminance, power and SH9 coefficients.
     Info {
@@ -201,14 +205,14 @@ fn main() -> ExitCode {
         Command::Validate(args) => validate::run(&args),
         Command::Test { adapter, args } => test::run(adapter.as_deref(), &args),
         Command::Info { path, json } => info::run(&path, json),
-        Command::Shafts { scene, json, source_share, leaf_size, prune, out } => {
+        Command::Shafts { scene, json, source_share, leaf_size, prune, out, sweep } => {
             let hierarchy = shaft_hierarchy::Settings { leaf_size, prune_fraction: prune, distant_reach: None };
             let settings = shaft_hierarchy::preprocess::PreprocessSettings {
                 source_share,
                 hierarchy,
                 ..shaft_hierarchy::preprocess::PreprocessSettings::PAPER
             };
-            shafts::run(&shafts::ShaftsArgs { scene: &scene, json, settings, out: &out })
+            shafts::run(&shafts::ShaftsArgs { scene: &scene, json, settings, sweep, out: &out })
         }
         Command::SoftShadows { scenes, size, adapter, out } => {
             soft_shadows::run(&scenes, size, adapter.as_deref(), &out)

@@ -8,8 +8,8 @@ use std::path::Path;
 use std::time::Instant;
 
 use real_scene::{PatchBvh, RealScene, SolveSettings, Visibility};
-use shaft_hierarchy::measure::{check, frame_times, median, object_path, overlay};
-use shaft_hierarchy::preprocess::{PreprocessSettings, build};
+use shaft_hierarchy::measure::{figures, object_path, overlay, sweep};
+use shaft_hierarchy::preprocess::PreprocessSettings;
 use shaft_hierarchy::{Occlusion, Traversal};
 
 /// Frames of the object path.
@@ -24,6 +24,7 @@ pub struct ShaftsArgs<'a> {
     pub scene: &'a str,
     pub json: bool,
     pub settings: PreprocessSettings,
+    pub sweep: bool,
     pub out: &'a Path,
 }
 
@@ -63,17 +64,42 @@ pub fn run(args: &ShaftsArgs) -> Result<(), String> {
             format!(", {} distant lights from the embedded map", lights.len())
         }
     ));
-    let t = Instant::now();
-    let (prepared, h) = build(&scene, &lights, &bvh, &args.settings).map_err(|e| e.to_string())?;
-    let preprocess_s = t.elapsed().as_secs_f64();
-    h.validate().map_err(|e| format!("the hierarchy is broken: {e}"))?;
+    if args.sweep {
+        say(
+            "knob sweep: setting | sources | leaf shafts | bytes (per leaf) | pre-processing | traversal | true occluders found | misses",
+        );
+        for (name, settings) in sweep() {
+            let (f, _, _) = figures(&scene, &lights, &bvh, &settings, (FRAMES, SEGMENTS_PER_FRAME, REPRESENTATIVES))?;
+            let line = format!(
+                "| {name} | {} | {} | {} ({:.1}) | {:.2} s | {:.1} us | {:.1} % | {} |",
+                f.sources,
+                f.leaf_shafts,
+                f.bytes,
+                f.bytes as f64 / f.leaf_shafts.max(1) as f64,
+                f.preprocess_s,
+                f.traversal_us,
+                100.0 * f.check.found as f64 / f.check.true_occluders.max(1) as f64,
+                f.check.misses
+            );
+            if args.json {
+                outln!(
+                    "{}",
+                    serde_json::json!({"setting": name, "sources": f.sources, "leaf_shafts": f.leaf_shafts, "bytes": f.bytes, "preprocess_s": f.preprocess_s, "traversal_us": f.traversal_us, "true_occluders_found": f.check.found as f64 / f.check.true_occluders.max(1) as f64, "misses": f.check.misses})
+                );
+            } else {
+                outln!("{line}");
+            }
+            if f.check.misses > 0 {
+                return Err(format!("{name}: {} occluded segments in no reported shaft", f.check.misses));
+            }
+        }
+        return Ok(());
+    }
+    let (f, prepared, h) =
+        figures(&scene, &lights, &bvh, &args.settings, (FRAMES, SEGMENTS_PER_FRAME, REPRESENTATIVES))?;
     let objects = object_path(&scene, FRAMES);
-    let c = check(&h, &prepared, &scene, &lights, &objects, SEGMENTS_PER_FRAME, 1);
-    // timing: the path three times, the median frame
-    let times: Vec<f64> = (0..3).flat_map(|_| frame_times(&h, &objects, REPRESENTATIVES)).collect();
-    let traversal_us = median(&times);
-    let bytes = h.bytes();
-    let leaf_shafts = h.leaf_shafts();
+    let c = f.check;
+    let (preprocess_s, traversal_us, bytes, leaf_shafts) = (f.preprocess_s, f.traversal_us, f.bytes, f.leaf_shafts);
     // the overlay at the path position nearest the middle of the view, among those in sight
     let (right, up, forward) = scene.camera.basis();
     let off_centre = |b: &shaft_hierarchy::Aabb| {

@@ -63,6 +63,27 @@ fn source_point(scene: &RealScene, lights: &[DistantLight], s: Source, x: Vec3, 
     }
 }
 
+/// (source, receiver) index pairs.
+pub type Pairs = HashSet<(u32, u32)>;
+
+/// Every (source, receiver) pair in a met leaf shaft, and in a met pruned pair.
+#[must_use]
+pub fn covered_pairs(h: &ShaftHierarchy, o: &Occlusion) -> (Pairs, Pairs) {
+    let expand = |nodes: &mut dyn Iterator<Item = (u32, u32)>| {
+        let mut set = HashSet::new();
+        for (source, receiver) in nodes {
+            for &j in h.source_tree.items(source) {
+                for &p in h.receiver_tree.items(receiver) {
+                    set.insert((j, p));
+                }
+            }
+        }
+        set
+    };
+    let kept = expand(&mut o.leaf_shafts.iter().map(|&k| (h.shafts[k as usize].source, h.shafts[k as usize].receiver)));
+    (kept, expand(&mut o.pruned.iter().copied()))
+}
+
 /// For each object, `per_object` segments from a random point of a random source to a random
 /// point of a random receiver patch (fixed seed); a segment that meets the object's box must lie
 /// in a shaft the traversal reported.
@@ -85,20 +106,7 @@ pub fn check(
     }
     for object in objects {
         h.traverse(object, &mut scratch, &mut o);
-        let pairs = |nodes: &mut dyn Iterator<Item = (u32, u32)>| {
-            let mut set = HashSet::new();
-            for (source, receiver) in nodes {
-                for &j in h.source_tree.items(source) {
-                    for &p in h.receiver_tree.items(receiver) {
-                        set.insert((j, p));
-                    }
-                }
-            }
-            set
-        };
-        let kept =
-            pairs(&mut o.leaf_shafts.iter().map(|&k| (h.shafts[k as usize].source, h.shafts[k as usize].receiver)));
-        let pruned = pairs(&mut o.pruned.iter().copied());
+        let (kept, pruned) = covered_pairs(h, &o);
         let reported: HashSet<u32> = o.sources.iter().copied().collect();
         let mut occluders = HashSet::new();
         for _ in 0..per_object {
@@ -212,4 +220,92 @@ fn ray_box(o: Vec3, d: Vec3, b: &Aabb) -> Option<f32> {
     let (t0, t1) = ((b.min - o) * inv, (b.max - o) * inv);
     let (near, far) = (t0.min(t1).max_element().max(0.0), t0.max(t1).min_element());
     (near <= far).then_some(near)
+}
+
+/// Everything `cargo xtask shafts` reports for one setting.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Figures {
+    /// The source set's size.
+    pub sources: usize,
+    /// Receiver patches.
+    pub receivers: usize,
+    /// Shaft nodes stored.
+    pub shafts: usize,
+    /// Leaf shafts (kept pairs).
+    pub leaf_shafts: usize,
+    /// Pairs pruned.
+    pub pruned_pairs: usize,
+    /// Bytes traversal needs ([`ShaftHierarchy::bytes`]).
+    pub bytes: usize,
+    /// Bytes of the transfer sums, besides.
+    pub transfer_bytes: usize,
+    /// The source set's share of the power.
+    pub power_share: f64,
+    /// Source set, receivers, transfers, trees and shafts, seconds.
+    pub preprocess_s: f64,
+    /// Traversal plus representative set, median microseconds per frame.
+    pub traversal_us: f64,
+    /// The brute-force check.
+    pub check: Check,
+}
+
+/// Pre-processes `scene` with `settings` (timed), validates, checks `per_frame` segments at
+/// each of `frames` positions of [`object_path`], and times three passes over the path with a
+/// representative set of `representatives`.
+///
+/// # Errors
+/// A build error, or the hierarchy's `validate` failing (in words).
+pub fn figures(
+    scene: &RealScene,
+    lights: &[DistantLight],
+    vis: &impl Visibility,
+    settings: &crate::preprocess::PreprocessSettings,
+    (frames, per_frame, representatives): (usize, usize, usize),
+) -> Result<(Figures, Prepared, ShaftHierarchy), String> {
+    let t = Instant::now();
+    let (prepared, h) = crate::preprocess::build(scene, lights, vis, settings).map_err(|e| e.to_string())?;
+    let preprocess_s = t.elapsed().as_secs_f64();
+    h.validate().map_err(|e| format!("the hierarchy is broken: {e}"))?;
+    let objects = object_path(scene, frames);
+    let check = check(&h, &prepared, scene, lights, &objects, per_frame, 1);
+    let times: Vec<f64> = (0..3).flat_map(|_| frame_times(&h, &objects, representatives)).collect();
+    let f = Figures {
+        sources: prepared.sources.len(),
+        receivers: prepared.receivers.len(),
+        shafts: h.shafts.len(),
+        leaf_shafts: h.leaf_shafts(),
+        pruned_pairs: h.pruned_pairs(),
+        bytes: h.bytes(),
+        transfer_bytes: h.transfer_bytes(),
+        power_share: prepared.power.0 / prepared.power.1.max(f64::MIN_POSITIVE),
+        preprocess_s,
+        traversal_us: median(&times),
+        check,
+    };
+    Ok((f, prepared, h))
+}
+
+/// The knobs swept by `cargo xtask shafts --sweep`: the paper's setting, then one knob at a
+/// time (source share, receivers per leaf, pruning threshold).
+#[must_use]
+pub fn sweep() -> Vec<(String, crate::preprocess::PreprocessSettings)> {
+    use crate::preprocess::PreprocessSettings as P;
+    let paper = P::PAPER;
+    let mut out = vec![("paper (70 %, 8 a leaf, 2 %)".to_string(), paper)];
+    for share in [0.5, 0.9] {
+        out.push((format!("source share {:.0} %", share * 100.0), P { source_share: share, ..paper }));
+    }
+    for leaf in [4, 16] {
+        out.push((
+            format!("{leaf} receivers a leaf"),
+            P { hierarchy: crate::Settings { leaf_size: leaf, ..paper.hierarchy }, ..paper },
+        ));
+    }
+    for prune in [0.0, 0.1] {
+        out.push((
+            format!("pruning {:.0} %", prune * 100.0),
+            P { hierarchy: crate::Settings { prune_fraction: prune, ..paper.hierarchy }, ..paper },
+        ));
+    }
+    out
 }

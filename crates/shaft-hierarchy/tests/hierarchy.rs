@@ -1,10 +1,9 @@
 //! The shaft hierarchy against brute force: random rooms, objects and segments.
 
-use std::collections::HashSet;
-
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
+use shaft_hierarchy::measure::covered_pairs;
 use shaft_hierarchy::{
     Aabb, BuildError, Kind, Occlusion, Receiver, Settings, ShaftHierarchy, SourceShape, Transfers, Traversal,
     cone_directions,
@@ -128,26 +127,6 @@ fn object(rng: &mut Pcg64) -> Aabb {
     }
 }
 
-/// (source, receiver) pairs.
-type Pairs = HashSet<(u32, u32)>;
-
-/// Every (source, receiver) pair a met leaf or pruned shaft covers.
-fn covered(h: &ShaftHierarchy, o: &Occlusion) -> (Pairs, Pairs) {
-    let pairs = |nodes: Vec<(u32, u32)>| {
-        let mut set = HashSet::new();
-        for (source, receiver) in nodes {
-            for &j in h.source_tree.items(source) {
-                for &p in h.receiver_tree.items(receiver) {
-                    set.insert((j, p));
-                }
-            }
-        }
-        set
-    };
-    let leaves = o.leaf_shafts.iter().map(|&k| (h.shafts[k as usize].source, h.shafts[k as usize].receiver)).collect();
-    (pairs(leaves), pairs(o.pruned.clone()))
-}
-
 #[test]
 fn hierarchy_validates() {
     let mut rng = Pcg64::seed_from_u64(7);
@@ -203,7 +182,7 @@ fn traversal_misses_no_occluded_segment() {
     for _ in 0..120 {
         let obj = object(&mut rng);
         h.traverse(&obj, &mut scratch, &mut o);
-        let (leaf_pairs, pruned_pairs) = covered(&h, &o);
+        let (leaf_pairs, pruned_pairs) = covered_pairs(&h, &o);
         reported += leaf_pairs.len();
         for _ in 0..1_000 {
             let j = rng.random_range(0..r.sources.len());
