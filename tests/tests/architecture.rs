@@ -56,8 +56,9 @@ fn transitive(graph: &HashMap<String, Vec<String>>, root: &str) -> BTreeSet<Stri
     seen
 }
 
-const OURS: [&str; 8] = [
+const OURS: [&str; 9] = [
     "envmap-sphere",
+    "real-scene",
     "light-extract",
     "shaft-hierarchy",
     "shadowmap-paraboloid",
@@ -105,4 +106,20 @@ fn gpu_layer_and_shadow_techniques_stand_apart_from_the_reference() {
             assert!(!shadows.contains(banned), "{technique} depends on {banned}");
         }
     }
+}
+
+#[test]
+fn shafts_ask_a_visibility_trait_and_never_touch_wgpu() {
+    // the shaft hierarchy asks `real_scene::Visibility` for rays, never ref-tracer itself
+    // (real-scene's `PatchBvh` answers with ref-tracer's BVH); neither knows the GPU
+    let graph = dependency_graph();
+    for krate in ["shaft-hierarchy", "real-scene"] {
+        let deps = transitive(&graph, krate);
+        assert!(deps.contains("scene"), "{krate}'s graph is incomplete: {deps:?}");
+        let gpu: Vec<_> = deps.iter().filter(|d| d.starts_with("wgpu") || *d == "gpu" || *d == "naga").collect();
+        assert!(gpu.is_empty(), "{krate} depends on {gpu:?}");
+    }
+    let direct = &graph["shaft-hierarchy"];
+    assert!(direct.iter().any(|d| d == "real-scene"), "{direct:?}");
+    assert!(!direct.iter().any(|d| d == "ref-tracer" || d == "obvhs"), "shaft-hierarchy traces rays itself: {direct:?}");
 }
