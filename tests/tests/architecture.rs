@@ -121,5 +121,8 @@ fn shafts_ask_a_visibility_trait_and_never_touch_wgpu() {
     }
     let direct = &graph["shaft-hierarchy"];
     assert!(direct.iter().any(|d| d == "real-scene"), "{direct:?}");
-    assert!(!direct.iter().any(|d| d == "ref-tracer" || d == "obvhs"), "shaft-hierarchy traces rays itself: {direct:?}");
+    assert!(
+        !direct.iter().any(|d| d == "ref-tracer" || d == "obvhs"),
+        "shaft-hierarchy traces rays itself: {direct:?}"
+    );
 }

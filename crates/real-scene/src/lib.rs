@@ -10,9 +10,11 @@
 
 mod builtin;
 pub mod formfactor;
+mod photo;
 mod radiosity;
 
 pub use builtin::{BUILTIN_REAL_SCENES, Perturbation};
+pub use photo::{CameraResponse, PhotoSettings, photograph};
 pub use radiosity::{SolveReport, SolveSettings, solve};
 
 use glam::Vec3;
@@ -184,7 +186,14 @@ pub enum RealSceneError {
     /// No built-in real scene of that name.
     #[error("unknown real scene {0:?}; built-in real scenes: {list}", list = BUILTIN_REAL_SCENES.join(", "))]
     Unknown(String),
-    /// An environment-lit scene was solved without a map.
-    #[error("{0} is lit by an environment map: give one")]
+    /// An environment-lit scene was solved without a map, or a scene without one was
+    /// photographed under a map.
+    #[error(
+        "{0}: the environment map and the scene's lighting disagree (environment-lit scenes need one, others take none)"
+    )]
     NeedsEnvironment(String),
+    /// A scene with emitting patches was photographed: `ref-tracer`'s path tracer has no
+    /// emitting surfaces yet, its only light is the map.
+    #[error("{0} has emitting patches, which ref-tracer's path tracer cannot render yet")]
+    NeedsEmitters(String),
 }

@@ -2,7 +2,8 @@
 //! radiance L_p = E_p + ρ_p (Σ_q F_pq V_pq L_q + L_env,p), gathered by Jacobi iteration. Form
 //! factors are point-to-patch from each patch's centre (exact contour integrals, so they sum to
 //! 1 in a closed room); visibility is the fraction of sample points of q the centre sees; the
-//! environment's share is a cosine-weighted stratified estimate of the rays that escape.
+//! environment's share is estimated from escaping rays, cosine-weighted and map-importance
+//! samples combined by the balance heuristic.
 
 use envmap_sphere::EnvMap;
 use glam::Vec3;
@@ -20,7 +21,8 @@ pub struct SolveSettings {
     pub tolerance: f32,
     /// n x n points on each patch for the visibility of a link.
     pub visibility_samples: u32,
-    /// n x n cosine-weighted directions per patch for the environment.
+    /// n x n cosine-weighted directions and as many map samples per patch for the
+    /// environment.
     pub environment_samples: u32,
 }
 
@@ -91,32 +93,46 @@ pub fn solve(
             out
         })
         .collect();
-    // what each patch reflects of the environment: ρ times the mean radiance of the escaping
-    // cosine-weighted directions (E / π)
+    // what each patch reflects of the environment: ρ E / π, E estimated from as many
+    // cosine-weighted directions as map-importance samples, combined by the balance heuristic
+    // (a small sun is found by the map samples, the broad sky by the cosine ones)
     let ne = settings.environment_samples.max(1);
-    let env: Vec<Vec3> = match environment {
-        None => vec![Vec3::ZERO; patches.len()],
-        Some(map) => frames
+    let dist = environment.map(envmap_sphere::EnvDistribution::for_bilinear);
+    let env: Vec<Vec3> = match (environment, &dist) {
+        (Some(map), Some(dist)) => frames
             .par_iter()
-            .map(|&(c, n)| {
+            .enumerate()
+            .map(|(k, &(c, n))| {
                 let origin = c + n * eps;
                 let (t, b) = n.any_orthonormal_pair();
-                let mut sum = Vec3::ZERO;
+                // a per-patch rotation of the stratified points (Cranley-Patterson)
+                let shift = glam::Vec2::new(hash(k as u32, 1), hash(k as u32, 2));
+                let mut e = Vec3::ZERO;
                 for j in 0..ne {
                     for i in 0..ne {
-                        let (u1, u2) = ((i as f32 + 0.5) / ne as f32, (j as f32 + 0.5) / ne as f32);
-                        let r = u1.sqrt();
-                        let phi = u2 * std::f32::consts::TAU;
+                        let u = (glam::Vec2::new((i as f32 + 0.5) / ne as f32, (j as f32 + 0.5) / ne as f32) + shift)
+                            .fract();
+                        // cosine-weighted
+                        let r = u.x.sqrt();
+                        let phi = u.y * std::f32::consts::TAU;
                         let d =
-                            (t * (r * phi.cos()) + b * (r * phi.sin()) + n * (1.0 - u1).max(0.0).sqrt()).normalize();
-                        if vis.escapes(origin, d) {
-                            sum += map.lookup(d);
+                            (t * (r * phi.cos()) + b * (r * phi.sin()) + n * (1.0 - u.x).max(0.0).sqrt()).normalize();
+                        let cos = d.dot(n);
+                        if cos > 0.0 && vis.escapes(origin, d) {
+                            e += map.lookup(d) * cos / (cos / std::f32::consts::PI + dist.dir_pdf(d));
+                        }
+                        // the map's
+                        let m = dist.sample_dir(u);
+                        let cos = m.dir.dot(n);
+                        if cos > 0.0 && m.pdf > 0.0 && vis.escapes(origin, m.dir) {
+                            e += map.lookup_uv(m.uv) * cos / (cos / std::f32::consts::PI + m.pdf);
                         }
                     }
                 }
-                sum / (ne * ne) as f32
+                e / (ne * ne) as f32 / std::f32::consts::PI
             })
             .collect(),
+        _ => vec![Vec3::ZERO; patches.len()],
     };
     let base: Vec<Vec3> = patches.iter().zip(&env).map(|(p, e)| p.emission + p.reflectance * *e).collect();
     let mut radiance = base.clone();
@@ -140,4 +156,15 @@ pub fn solve(
         p.radiance = l;
     }
     Ok(SolveReport { iterations, change, links: links_count })
+}
+
+/// A number in [0, 1) from (k, salt): PCG-style integer hashing.
+fn hash(k: u32, salt: u32) -> f32 {
+    let mut x = k.wrapping_mul(0x9E37_79B9) ^ salt.wrapping_mul(0x85EB_CA6B);
+    x ^= x >> 16;
+    x = x.wrapping_mul(0x7FEB_352D);
+    x ^= x >> 15;
+    x = x.wrapping_mul(0x846C_A68B);
+    x ^= x >> 16;
+    (x >> 8) as f32 / (1u32 << 24) as f32
 }
