@@ -178,6 +178,11 @@ enum Command {
         /// Output folder of the overlay image.
         #[arg(long, default_value = "target/shafts")]
         out: PathBuf,
+        /// Also path trace the scene's photograph at this many spp (HDR and 8-bit through an
+        /// auto-exposed camera response; environment-lit scenes only, as ref-tracer's path
+        /// tracer has no emitting surfaces yet).
+        #[arg(long)]
+        photo: Option<u32>,
         /// Instead, sweep the knobs one at a time (source share, leaf size, pruning) and print
         /// a row each: time, memory and the fraction of true occluders found.
         #[arg(long)]
@@ -205,14 +210,14 @@ fn main() -> ExitCode {
         Command::Validate(args) => validate::run(&args),
         Command::Test { adapter, args } => test::run(adapter.as_deref(), &args),
         Command::Info { path, json } => info::run(&path, json),
-        Command::Shafts { scene, json, source_share, leaf_size, prune, out, sweep } => {
+        Command::Shafts { scene, json, source_share, leaf_size, prune, out, sweep, photo } => {
             let hierarchy = shaft_hierarchy::Settings { leaf_size, prune_fraction: prune, distant_reach: None };
             let settings = shaft_hierarchy::preprocess::PreprocessSettings {
                 source_share,
                 hierarchy,
                 ..shaft_hierarchy::preprocess::PreprocessSettings::PAPER
             };
-            shafts::run(&shafts::ShaftsArgs { scene: &scene, json, settings, sweep, out: &out })
+            shafts::run(&shafts::ShaftsArgs { scene: &scene, json, settings, sweep, photo, out: &out })
         }
         Command::SoftShadows { scenes, size, adapter, out } => {
             soft_shadows::run(&scenes, size, adapter.as_deref(), &out)

@@ -25,6 +25,7 @@ pub struct ShaftsArgs<'a> {
     pub json: bool,
     pub settings: PreprocessSettings,
     pub sweep: bool,
+    pub photo: Option<u32>,
     pub out: &'a Path,
 }
 
@@ -64,6 +65,9 @@ pub fn run(args: &ShaftsArgs) -> Result<(), String> {
             format!(", {} distant lights from the embedded map", lights.len())
         }
     ));
+    if let Some(spp) = args.photo {
+        photograph(&scene, map.as_ref(), spp, args.out)?;
+    }
     if args.sweep {
         say(
             "knob sweep: setting | sources | leaf shafts | bytes (per leaf) | pre-processing | traversal | true occluders found | misses",
@@ -175,5 +179,35 @@ pub fn run(args: &ShaftsArgs) -> Result<(), String> {
     if c.misses > 0 {
         return Err(format!("{} occluded segments in no reported shaft", c.misses));
     }
+    Ok(())
+}
+
+/// The scene's photograph: path traced (HDR, OUT/<scene>_photo.exr) and through an
+/// auto-exposed camera response to 8 bits (OUT/<scene>_photo.png).
+fn photograph(scene: &RealScene, map: Option<&envmap_sphere::EnvMap>, spp: u32, out: &Path) -> Result<(), String> {
+    let map = map.ok_or_else(|| {
+        format!("{}: no photograph: {}", scene.name, real_scene::RealSceneError::NeedsEmitters(scene.name.clone()))
+    })?;
+    let t = Instant::now();
+    let photo =
+        real_scene::photograph(scene, map, &real_scene::PhotoSettings { spp, ..real_scene::PhotoSettings::default() })
+            .map_err(|e| e.to_string())?;
+    let response = real_scene::CameraResponse::auto(&photo.color);
+    std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
+    let exr = out.join(format!("{}_photo.exr", scene.name));
+    envmap_sphere::io::save_exr_rgb(&exr, photo.width as usize, photo.height as usize, &photo.color)
+        .map_err(|e| e.to_string())?;
+    let png = out.join(format!("{}_photo.png", scene.name));
+    let ldr: Vec<u8> = photo.color.iter().flat_map(|&c| response.apply(c)).collect();
+    envmap_sphere::io::save_png_srgb8(&png, photo.width, photo.height, &ldr).map_err(|e| e.to_string())?;
+    let clipped = photo.color.iter().filter(|c| c.to_array().iter().any(|&v| response.clips(v))).count();
+    outln!(
+        "photograph: path traced, {spp} spp, {:.1} s; exposure {:.3}, gamma {}, {clipped} pixels clip; wrote {} and {}",
+        t.elapsed().as_secs_f64(),
+        response.exposure,
+        response.gamma,
+        exr.display(),
+        png.display()
+    );
     Ok(())
 }

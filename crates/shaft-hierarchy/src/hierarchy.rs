@@ -539,18 +539,37 @@ impl ShaftHierarchy {
     /// each once. A shaft inside the object's box (and so every shaft below it) is descended
     /// without further tests; the pruned children of a shaft it meets are listed untested.
     pub fn traverse(&self, object: &Aabb, scratch: &mut Traversal, out: &mut Occlusion) {
+        self.traverse_boxes(std::slice::from_ref(object), scratch, out);
+    }
+
+    /// As [`ShaftHierarchy::traverse`] for an object bounded by several boxes (its own small
+    /// hierarchy's leaves): a shaft is met when any box meets it, and covered when one box
+    /// covers it. Tighter than one box around them all.
+    pub fn traverse_boxes(&self, boxes: &[Aabb], scratch: &mut Traversal, out: &mut Occlusion) {
         out.sources.clear();
         out.receivers.clear();
         out.leaf_shafts.clear();
         out.pruned.clear();
         out.tested = 0;
+        let object = boxes.iter().fold(Aabb::EMPTY, |u, b| u.union(b));
         if object.is_empty() {
             return;
         }
+        let meet = |a: &Aabb, b: &Aabb| {
+            let mut verdict = Meet::Outside;
+            for o in boxes.iter().filter(|o| !o.is_empty()) {
+                match meets(a, b, o) {
+                    Meet::Covers => return Meet::Covers,
+                    Meet::Partial => verdict = Meet::Partial,
+                    Meet::Outside => {}
+                }
+            }
+            verdict
+        };
         if self.root_pruned {
             let (a, b) = self.ends(0, 0);
             out.tested = 1;
-            if meets(&a, &b, object) != Meet::Outside {
+            if meet(&a, &b) != Meet::Outside {
                 out.pruned.push((0, 0));
             }
             return;
@@ -575,7 +594,7 @@ impl ShaftHierarchy {
             let inside = inside || {
                 out.tested += 1;
                 let (a, b) = self.ends(n.source, n.receiver);
-                match meets(&a, &b, object) {
+                match meet(&a, &b) {
                     Meet::Outside => continue,
                     Meet::Partial => false,
                     Meet::Covers => true,

@@ -20,6 +20,27 @@ pub enum Source {
     Distant(u32),
 }
 
+/// Where a representative's shadow map is rendered from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Origin {
+    /// A point: the centre of a source patch.
+    Point(Vec3),
+    /// A direction towards a distant light (an orthographic map).
+    Direction(Vec3),
+}
+
+impl Prepared {
+    /// The shadow map origin of source `s` of the source set (paper 003, Section 8: a cluster's
+    /// map is rendered from its strongest patch's centre).
+    #[must_use]
+    pub fn origin(&self, scene: &RealScene, lights: &[DistantLight], s: u32) -> Origin {
+        match self.sources[s as usize] {
+            Source::Patch(j) => Origin::Point(scene.patches[j as usize].center()),
+            Source::Distant(k) => Origin::Direction(lights[k as usize].direction),
+        }
+    }
+}
+
 /// Knobs of the pre-processing.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PreprocessSettings {

@@ -357,3 +357,24 @@ fn bad_input_is_an_error() {
     empty.validate().unwrap();
     assert_eq!(empty.leaf_shafts(), 0);
 }
+
+/// An object of several boxes reports exactly the union of what each box reports.
+#[test]
+fn several_boxes_report_the_union_of_each() {
+    let mut rng = Pcg64::seed_from_u64(14);
+    let r = room(&mut rng, 40, 3, 8);
+    let h = ShaftHierarchy::build(&r.sources, &r.receivers, &r.transfers, &Settings::PAPER).unwrap();
+    let mut scratch = Traversal::default();
+    let mut o = Occlusion::default();
+    for _ in 0..40 {
+        let boxes = [object(&mut rng), object(&mut rng), Aabb::EMPTY];
+        let mut expected = std::collections::BTreeSet::new();
+        for b in &boxes {
+            h.traverse(b, &mut scratch, &mut o);
+            expected.extend(o.sources.iter().copied());
+        }
+        h.traverse_boxes(&boxes, &mut scratch, &mut o);
+        let got: std::collections::BTreeSet<u32> = o.sources.iter().copied().collect();
+        assert_eq!(got, expected);
+    }
+}
