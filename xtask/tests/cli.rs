@@ -406,3 +406,35 @@ fn eval_lights_writes_both_tables_with_a_noise_floor() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.trim().lines().count() == 1 && err.contains("no-such-method"), "{err}");
 }
+
+#[test]
+fn shafts_json_has_the_interface_keys_and_misses_nothing() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli-shafts");
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = xtask(&["shafts", "--scene", "ar_ground", "--json", "--out", dir.to_str().unwrap_or_default()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(text.trim().lines().count(), 1, "one JSON object on one line: {text}");
+    let v: serde_json::Value = serde_json::from_str(&text).expect("valid JSON");
+    for k in [
+        "patches",
+        "sources",
+        "receivers",
+        "leaf_shafts",
+        "bytes",
+        "preprocess_s",
+        "traversal_us",
+        "segments_checked",
+        "misses",
+    ] {
+        assert!(v.get(k).is_some_and(serde_json::Value::is_number), "missing number {k} in {v}");
+    }
+    assert_eq!(v["patches"].as_u64(), Some(1_108));
+    assert_eq!(v["misses"].as_u64(), Some(0));
+    assert!(v["segments_checked"].as_u64().unwrap_or(0) >= 100_000);
+    assert!(v["leaf_shafts"].as_u64().unwrap_or(0) > 0 && v["bytes"].as_u64().unwrap_or(0) > 0);
+    assert!(dir.join("ar_ground_overlay.png").is_file(), "the overlay image");
+    let bad = xtask(&["shafts", "--scene", "nope"]);
+    assert_eq!(bad.status.code(), Some(1));
+    assert_eq!(String::from_utf8_lossy(&bad.stderr).trim().lines().count(), 1);
+}
