@@ -132,3 +132,16 @@ fn pipeline_misses_nothing_on_real_scenes() {
         assert_eq!(c.misses, 0, "{name}: {c:?}");
     }
 }
+
+/// Pre-processing runs on rayon and gives the same hierarchy every time.
+#[test]
+fn preprocessing_is_deterministic() {
+    let mut scene = RealScene::builtin_with("ar_room", &Perturbation { coarsen: 2, ..Perturbation::NONE }).unwrap();
+    let bvh = PatchBvh::new(&scene);
+    solve(&mut scene, &bvh, None, &SolveSettings::default()).unwrap();
+    let (p1, h1) = build(&scene, &[], &bvh, &PreprocessSettings::PAPER).unwrap();
+    let (p2, h2) = build(&scene, &[], &bvh, &PreprocessSettings::PAPER).unwrap();
+    assert_eq!(p1.transfers, p2.transfers);
+    assert_eq!(p1.sources, p2.sources);
+    assert_eq!((h1.shafts, h1.leaf_transfer), (h2.shafts, h2.leaf_transfer));
+}
