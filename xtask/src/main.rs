@@ -178,9 +178,8 @@ enum Command {
         /// Output folder of the overlay image.
         #[arg(long, default_value = "target/shafts")]
         out: PathBuf,
-        /// Also path trace the scene's photograph at this many spp (HDR and 8-bit through an
-        /// auto-exposed camera response; environment-lit scenes only, as ref-tracer's path
-        /// tracer has no emitting surfaces yet).
+        /// Also path trace the scene's photograph at this many spp (HDR, and 8-bit through an
+        /// auto-exposed camera response).
         #[arg(long)]
         photo: Option<u32>,
         /// Instead, sweep the knobs one at a time (source share, leaf size, pruning) and print

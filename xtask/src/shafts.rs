@@ -185,9 +185,6 @@ pub fn run(args: &ShaftsArgs) -> Result<(), String> {
 /// The scene's photograph: path traced (HDR, OUT/<scene>_photo.exr) and through an
 /// auto-exposed camera response to 8 bits (OUT/<scene>_photo.png).
 fn photograph(scene: &RealScene, map: Option<&envmap_sphere::EnvMap>, spp: u32, out: &Path) -> Result<(), String> {
-    let map = map.ok_or_else(|| {
-        format!("{}: no photograph: {}", scene.name, real_scene::RealSceneError::NeedsEmitters(scene.name.clone()))
-    })?;
     let t = Instant::now();
     let photo =
         real_scene::photograph(scene, map, &real_scene::PhotoSettings { spp, ..real_scene::PhotoSettings::default() })

@@ -192,8 +192,4 @@ pub enum RealSceneError {
         "{0}: the environment map and the scene's lighting disagree (environment-lit scenes need one, others take none)"
     )]
     NeedsEnvironment(String),
-    /// A scene with emitting patches was photographed: `ref-tracer`'s path tracer has no
-    /// emitting surfaces yet, its only light is the map.
-    #[error("{0} has emitting patches, which ref-tracer's path tracer cannot render yet")]
-    NeedsEmitters(String),
 }

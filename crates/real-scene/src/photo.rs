@@ -1,5 +1,5 @@
 //! The photograph of a real scene, and the camera that takes it: `ref-tracer`'s path tracer
-//! renders the HDR image from the scene's camera; a [`CameraResponse`] (exposure, a response
+//! (with the scene's emitting patches) renders the HDR image from the scene's camera; a [`CameraResponse`] (exposure, a response
 //! curve, clipping, 8 bits) turns it into the LDR photograph paper 003 composites into.
 
 use envmap_sphere::EnvMap;
@@ -80,36 +80,29 @@ impl Default for PhotoSettings {
     }
 }
 
-/// The HDR photograph: the scene's model path traced from its camera under `map` (with AOVs:
-/// `object_id` is the patch a pixel sees).
+/// The HDR photograph: the scene's model path traced from its camera (`ref-tracer`'s
+/// `PathEmissive`: the emitting patches, and the map when the scene is environment-lit), with
+/// AOVs (`object_id` is the patch a pixel sees).
 ///
 /// # Errors
-/// [`RealSceneError::NeedsEmitters`] when patches emit (the path tracer's only light is the
-/// map); [`RealSceneError::NeedsEnvironment`] for a scene not lit by a map.
+/// [`RealSceneError::NeedsEnvironment`] when `map` is missing for an environment-lit scene, or
+/// given for one lit by its own patches.
 pub fn photograph(
     scene: &RealScene,
-    map: &EnvMap,
+    map: Option<&EnvMap>,
     settings: &PhotoSettings,
 ) -> Result<ref_tracer::Render, RealSceneError> {
-    if scene.patches.iter().any(|p| p.emission.max_element() > 0.0) {
-        return Err(RealSceneError::NeedsEmitters(scene.name.clone()));
-    }
-    if !scene.environment_lit {
+    if scene.environment_lit != map.is_some() {
         return Err(RealSceneError::NeedsEnvironment(scene.name.clone()));
     }
     let s = scene.to_scene();
     let bvh = ref_tracer::SceneBvh::new(&s);
-    let env = ref_tracer::EnvLight::new(map);
+    let env = map.map(ref_tracer::EnvLight::new);
+    let emission: Vec<Vec3> = scene.patches.iter().map(|p| p.emission).collect();
     let rs =
         ref_tracer::RenderSettings { spp: settings.spp, seed: settings.seed, ..ref_tracer::RenderSettings::default() };
-    Ok(ref_tracer::render(
-        &s,
-        &bvh,
-        Some(&env),
-        &ref_tracer::Integrator::Path { max_depth: settings.max_depth },
-        &rs,
-        &|_, _| {},
-    ))
+    let integrator = ref_tracer::Integrator::PathEmissive { max_depth: settings.max_depth, emission: &emission };
+    Ok(ref_tracer::render(&s, &bvh, env.as_ref(), &integrator, &rs, &|_, _| {}))
 }
 
 #[cfg(test)]

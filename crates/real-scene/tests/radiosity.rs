@@ -130,7 +130,7 @@ fn ar_ground_radiosity_matches_path_tracing() {
     let bvh = PatchBvh::new(&s);
     solve(&mut s, &bvh, Some(&map), &SolveSettings { environment_samples: 32, ..SolveSettings::default() }).unwrap();
     let photo =
-        real_scene::photograph(&s, &map, &real_scene::PhotoSettings { spp: 64, max_depth: 8, seed: 1 }).unwrap();
+        real_scene::photograph(&s, Some(&map), &real_scene::PhotoSettings { spp: 64, max_depth: 8, seed: 1 }).unwrap();
     let mut sum = vec![(Vec3::ZERO, 0u32); s.patches.len()];
     for (c, &o) in photo.color.iter().zip(&photo.object_id) {
         if let Some(e) = sum.get_mut(o as usize) {
@@ -157,11 +157,53 @@ fn ar_ground_radiosity_matches_path_tracing() {
 }
 
 #[test]
-fn photographs_need_the_lighting_path_tracing_has() {
+fn photographs_need_the_scenes_own_lighting() {
     let map = EnvMap::constant(16, 8, Vec3::ONE);
     let room = RealScene::builtin("ar_room").unwrap();
     assert!(matches!(
-        real_scene::photograph(&room, &map, &real_scene::PhotoSettings::default()),
-        Err(RealSceneError::NeedsEmitters(_))
+        real_scene::photograph(&room, Some(&map), &real_scene::PhotoSettings::default()),
+        Err(RealSceneError::NeedsEnvironment(_))
     ));
+    let ground = RealScene::builtin("ar_ground").unwrap();
+    assert!(matches!(
+        real_scene::photograph(&ground, None, &real_scene::PhotoSettings::default()),
+        Err(RealSceneError::NeedsEnvironment(_))
+    ));
+}
+
+/// The room lit by its lamp and window: the radiosity solution against the path tracer with
+/// emitting patches, patch by patch.
+#[test]
+fn ar_room_radiosity_matches_path_tracing() {
+    let mut s = RealScene::builtin("ar_room").unwrap();
+    (s.camera.width, s.camera.height) = (96, 72);
+    let bvh = PatchBvh::new(&s);
+    solve(&mut s, &bvh, None, &SolveSettings::default()).unwrap();
+    let photo =
+        real_scene::photograph(&s, None, &real_scene::PhotoSettings { spp: 128, max_depth: 12, seed: 1 }).unwrap();
+    let mut sum = vec![(Vec3::ZERO, 0u32); s.patches.len()];
+    for (c, &o) in photo.color.iter().zip(&photo.object_id) {
+        if let Some(e) = sum.get_mut(o as usize) {
+            e.0 += *c;
+            e.1 += 1;
+        }
+    }
+    let mut errors: Vec<f32> = Vec::new();
+    let (mut solved, mut traced) = (0.0f64, 0.0f64);
+    for (p, &(c, n)) in s.patches.iter().zip(&sum) {
+        if n >= 12 {
+            let mean = real_scene::luminance(c / n as f32);
+            let l = real_scene::luminance(p.radiance);
+            errors.push((l - mean).abs() / mean.max(1e-6));
+            solved += f64::from(l) * f64::from(n);
+            traced += f64::from(mean) * f64::from(n);
+        }
+    }
+    errors.sort_by(f32::total_cmp);
+    let median = errors[errors.len() / 2];
+    assert!(errors.len() > 50, "{} patches seen", errors.len());
+    // per patch mostly the path tracer's noise (its lamp is found by BRDF samples only): 7 %
+    // median at 128 spp; the image's mean agrees within 0.3 %
+    assert!(median < 0.12, "median relative error per patch {median}");
+    assert!((solved / traced - 1.0).abs() < 0.02, "pixel-weighted mean: radiosity {solved} vs path {traced}");
 }

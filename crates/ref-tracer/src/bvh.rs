@@ -25,6 +25,9 @@ pub struct SurfacePoint {
     pub shading_normal: Vec3,
     /// Index of the object in the scene.
     pub object: u32,
+    /// True when the ray hit the triangle's front side (counter-clockwise as the ray sees it):
+    /// one-sided emitters emit from there.
+    pub front: bool,
 }
 
 /// A BVH over every triangle of a scene.
@@ -130,13 +133,14 @@ impl SceneBvh {
             }
             None => ng,
         };
-        if ng.dot(dir) > 0.0 {
+        let front = ng.dot(dir) < 0.0;
+        if !front {
             ng = -ng;
         }
         if ns.dot(ng) < 0.0 {
             ns = -ns;
         }
-        SurfacePoint { t, position, geometric_normal: ng, shading_normal: ns, object }
+        SurfacePoint { t, position, geometric_normal: ng, shading_normal: ns, object, front }
     }
 }
 

@@ -8,8 +8,11 @@
 //!   irradiance on the diffuse lobe, the ambient map on the specular lobe by MIS pairs of a map
 //!   sample and a BRDF sample (unshadowed, or shadowed by sampled visibility).
 //! - `Path`: multi-bounce path tracing with the same MIS next-event estimation at every vertex.
+//! - `PathEmissive`: the same with emitting objects (one-sided, found by BRDF samples) and the
+//!   map optional: the truth for scenes lit by their own lamps and windows.
 //!
-//! Surfaces do not emit; the map is the only light of `EnvDirect` and `Path`.
+//! Only `PathEmissive` knows emitting surfaces; elsewhere the map (or the lights) is the only
+//! light.
 
 use crate::bvh::{SceneBvh, SurfacePoint};
 use crate::sampler::PixelSampler;
@@ -137,6 +140,16 @@ pub enum Integrator<'a> {
         /// Number of scattering events with next-event estimation.
         max_depth: u32,
     },
+    /// Path tracing with emitting objects: `emission[object]` leaves the front faces (one-sided,
+    /// as a lamp's patch), and the map is optional. Emitters are found by the BRDF samples
+    /// only (no next-event estimation towards them: unbiased, noisy for small bright ones).
+    /// `max_depth` = d collects emitters seen directly and through up to d bounces.
+    PathEmissive {
+        /// Number of scattering events.
+        max_depth: u32,
+        /// Radiance each object emits from its front faces (missing objects emit nothing).
+        emission: &'a [Vec3],
+    },
 }
 
 fn power_heuristic(a: f32, b: f32) -> f32 {
@@ -204,7 +217,10 @@ impl Integrator<'_> {
                 None => set.background.map_or(Vec3::ZERO, |m| m.lookup(dir)),
                 Some(sp) => lights_direct(bvh, set, &Shading::new(bvh, &sp, dir), s),
             },
-            Self::Path { max_depth } => path(bvh, env.expect("Path needs the map"), origin, dir, *max_depth, s),
+            Self::Path { max_depth } => {
+                path(bvh, Some(env.expect("Path needs the map")), &[], origin, dir, *max_depth, s)
+            }
+            Self::PathEmissive { max_depth, emission } => path(bvh, env, emission, origin, dir, *max_depth, s),
         }
     }
 }
@@ -368,18 +384,43 @@ fn arriving(bvh: &SceneBvh, sh: &Shading, dir: Vec3, lit: Vec3, ambient: Vec3, s
     if shadowed != Vec3::ZERO && !bvh.occluded(sh.origin(), dir, f32::INFINITY) { free + shadowed } else { free }
 }
 
-fn path(bvh: &SceneBvh, env: &EnvLight, origin: Vec3, dir: Vec3, max_depth: u32, s: &mut PixelSampler) -> Vec3 {
-    let (mut l, mut beta) = (Vec3::ZERO, Vec3::ONE);
-    let Some(mut sp) = bvh.intersect(origin, dir, f32::INFINITY) else { return env.map.lookup(dir) };
+fn path(
+    bvh: &SceneBvh,
+    env: Option<&EnvLight>,
+    emission: &[Vec3],
+    origin: Vec3,
+    dir: Vec3,
+    max_depth: u32,
+    s: &mut PixelSampler,
+) -> Vec3 {
+    let emitted = |sp: &SurfacePoint| {
+        if sp.front { emission.get(sp.object as usize).copied().unwrap_or(Vec3::ZERO) } else { Vec3::ZERO }
+    };
+    let Some(mut sp) = bvh.intersect(origin, dir, f32::INFINITY) else {
+        return env.map_or(Vec3::ZERO, |e| e.map.lookup(dir));
+    };
+    let (mut l, mut beta) = (emitted(&sp), Vec3::ONE);
     let mut d = dir;
     for depth in 0..max_depth {
         let sh = Shading::new(bvh, &sp, d);
-        // NEE with MIS; a BRDF ray that escapes is counted inside env_direct, so the path
-        // continues only through its hit.
-        let (direct, next) = env_direct(bvh, env, &sh, Strategy::Mis, depth + 1 < max_depth, s);
-        l += beta * direct;
+        let last = depth + 1 == max_depth;
+        // the BRDF ray is traced to go on, and from the last vertex only to find emitters
+        let next = match env {
+            Some(env) => {
+                // NEE with MIS; a BRDF ray that escapes is counted inside env_direct, so the
+                // path continues only through its hit
+                let (direct, next) = env_direct(bvh, env, &sh, Strategy::Mis, !last || !emission.is_empty(), s);
+                l += beta * direct;
+                next
+            }
+            None => brdf_continuation(bvh, &sh, s),
+        };
         let Some(Continuation { dir: wi, weight, hit: Some(hit) }) = next else { break };
         beta *= weight;
+        l += beta * emitted(&hit);
+        if last {
+            break;
+        }
         if depth >= 3 {
             // Russian roulette
             let q = beta.max_element().min(0.95);
@@ -391,4 +432,17 @@ fn path(bvh: &SceneBvh, env: &EnvLight, origin: Vec3, dir: Vec3, max_depth: u32,
         (sp, d) = (hit, wi);
     }
     l
+}
+
+/// A BRDF-sampled continuation without a map (emitters only), traced to its hit.
+fn brdf_continuation(bvh: &SceneBvh, sh: &Shading, s: &mut PixelSampler) -> Option<Continuation> {
+    let (u_brdf, u_lobe) = (s.next_2d(), s.next_1d());
+    let (wi, pdf) = sh.material.sample_brdf(sh.wo, u_brdf, u_lobe)?;
+    let wi_world = sh.frame.to_world(wi);
+    let (fc, _) = sh.f_cos(wi_world);
+    (fc != Vec3::ZERO && pdf > 0.0).then(|| Continuation {
+        dir: wi_world,
+        weight: fc / pdf,
+        hit: bvh.intersect(sh.origin(), wi_world, f32::INFINITY),
+    })
 }
