@@ -5,7 +5,7 @@
 use envmap_sphere::EnvMap;
 use glam::Vec3;
 
-use crate::{RealScene, RealSceneError, luminance};
+use crate::{RealScene, RealSceneError};
 
 /// A camera's response T: code = round(255 · clamp((exposure · L / white)^(1 / gamma), 0, 1))
 /// per channel, 8 bits.
@@ -21,10 +21,10 @@ pub struct CameraResponse {
 
 impl CameraResponse {
     /// The response for a scene: exposure so that the 99th percentile of the HDR image's
-    /// luminance reaches the white point; gamma 2.2.
+    /// brightest channel reaches the white point (so about 1 % of pixels clip); gamma 2.2.
     #[must_use]
     pub fn auto(hdr: &[Vec3]) -> Self {
-        let mut l: Vec<f32> = hdr.iter().map(|&c| luminance(c)).filter(|v| v.is_finite()).collect();
+        let mut l: Vec<f32> = hdr.iter().map(|&c| c.max_element()).filter(|v| v.is_finite()).collect();
         l.sort_by(f32::total_cmp);
         let p99 = l.get(l.len() * 99 / 100).copied().unwrap_or(1.0);
         Self { exposure: if p99 > 0.0 { 1.0 / p99 } else { 1.0 }, gamma: 2.2, white: 1.0 }
@@ -101,7 +101,8 @@ pub fn photograph(
     let emission: Vec<Vec3> = scene.patches.iter().map(|p| p.emission).collect();
     let rs =
         ref_tracer::RenderSettings { spp: settings.spp, seed: settings.seed, ..ref_tracer::RenderSettings::default() };
-    let integrator = ref_tracer::Integrator::PathEmissive { max_depth: settings.max_depth, emission: &emission };
+    let emitters = ref_tracer::Emitters::new(&s, &emission);
+    let integrator = ref_tracer::Integrator::PathEmissive { max_depth: settings.max_depth, emitters: &emitters };
     Ok(ref_tracer::render(&s, &bvh, env.as_ref(), &integrator, &rs, &|_, _| {}))
 }
 

@@ -15,6 +15,7 @@
 //! light.
 
 use crate::bvh::{SceneBvh, SurfacePoint};
+use crate::emitters::Emitters;
 use crate::sampler::PixelSampler;
 use envmap_sphere::{EnvDistribution, EnvMap, Sh9};
 use glam::Vec3;
@@ -140,15 +141,15 @@ pub enum Integrator<'a> {
         /// Number of scattering events with next-event estimation.
         max_depth: u32,
     },
-    /// Path tracing with emitting objects: `emission[object]` leaves the front faces (one-sided,
-    /// as a lamp's patch), and the map is optional. Emitters are found by the BRDF samples
-    /// only (no next-event estimation towards them: unbiased, noisy for small bright ones).
-    /// `max_depth` = d collects emitters seen directly and through up to d bounces.
+    /// Path tracing with emitting objects (one-sided, as a lamp's patch: see [`Emitters`]),
+    /// the map optional. At every vertex, next-event estimation towards a point of an emitter
+    /// (chosen by power) and the BRDF sample that hits one are combined by MIS (power
+    /// heuristic). `max_depth` = d collects emitters seen directly and through up to d bounces.
     PathEmissive {
         /// Number of scattering events.
         max_depth: u32,
-        /// Radiance each object emits from its front faces (missing objects emit nothing).
-        emission: &'a [Vec3],
+        /// The scene's emitters.
+        emitters: &'a Emitters,
     },
 }
 
@@ -218,9 +219,9 @@ impl Integrator<'_> {
                 Some(sp) => lights_direct(bvh, set, &Shading::new(bvh, &sp, dir), s),
             },
             Self::Path { max_depth } => {
-                path(bvh, Some(env.expect("Path needs the map")), &[], origin, dir, *max_depth, s)
+                path(bvh, Some(env.expect("Path needs the map")), None, origin, dir, *max_depth, s)
             }
-            Self::PathEmissive { max_depth, emission } => path(bvh, env, emission, origin, dir, *max_depth, s),
+            Self::PathEmissive { max_depth, emitters } => path(bvh, env, Some(emitters), origin, dir, *max_depth, s),
         }
     }
 }
@@ -231,6 +232,8 @@ struct Continuation {
     dir: Vec3,
     /// f cos / pdf.
     weight: Vec3,
+    /// The BRDF sample's density per solid angle.
+    pdf: f32,
     /// What the ray hits (`None`: it escaped, and its light was counted), when asked for.
     hit: Option<SurfacePoint>,
 }
@@ -269,7 +272,7 @@ fn env_direct(
             let w = env_pdf.map_or(1.0, |env_pdf| power_heuristic(pdf, env_pdf));
             fc * env.map.lookup_uv(uv) * (w / pdf)
         });
-        (wi_world, fc / pdf, term)
+        (wi_world, fc / pdf, pdf, term)
     });
     let env_term = env_sample.and_then(|ls| {
         let (fc, wi) = sh.f_cos(ls.dir);
@@ -285,13 +288,13 @@ fn env_direct(
         l += term;
     }
     let mut next = None;
-    if let Some((wi_world, weight, term)) = brdf_sample {
+    if let Some((wi_world, weight, pdf, term)) = brdf_sample {
         let hit = if trace_brdf_ray { bvh.intersect(sh.origin(), wi_world, f32::INFINITY) } else { None };
         let escaped = if trace_brdf_ray { hit.is_none() } else { !bvh.occluded(sh.origin(), wi_world, f32::INFINITY) };
         if escaped && let Some(term) = term {
             l += term;
         }
-        next = Some(Continuation { dir: wi_world, weight, hit });
+        next = Some(Continuation { dir: wi_world, weight, pdf, hit });
     }
     (l, next)
 }
@@ -387,14 +390,16 @@ fn arriving(bvh: &SceneBvh, sh: &Shading, dir: Vec3, lit: Vec3, ambient: Vec3, s
 fn path(
     bvh: &SceneBvh,
     env: Option<&EnvLight>,
-    emission: &[Vec3],
+    emitters: Option<&Emitters>,
     origin: Vec3,
     dir: Vec3,
     max_depth: u32,
     s: &mut PixelSampler,
 ) -> Vec3 {
-    let emitted = |sp: &SurfacePoint| {
-        if sp.front { emission.get(sp.object as usize).copied().unwrap_or(Vec3::ZERO) } else { Vec3::ZERO }
+    let emitters = emitters.filter(|e| !e.is_empty());
+    let emitted = |sp: &SurfacePoint| match emitters {
+        Some(e) if sp.front => e.emission(sp.object),
+        _ => Vec3::ZERO,
     };
     let Some(mut sp) = bvh.intersect(origin, dir, f32::INFINITY) else {
         return env.map_or(Vec3::ZERO, |e| e.map.lookup(dir));
@@ -404,20 +409,31 @@ fn path(
     for depth in 0..max_depth {
         let sh = Shading::new(bvh, &sp, d);
         let last = depth + 1 == max_depth;
+        if let Some(e) = emitters {
+            l += beta * emitter_direct(bvh, e, &sh, s);
+        }
         // the BRDF ray is traced to go on, and from the last vertex only to find emitters
         let next = match env {
             Some(env) => {
                 // NEE with MIS; a BRDF ray that escapes is counted inside env_direct, so the
                 // path continues only through its hit
-                let (direct, next) = env_direct(bvh, env, &sh, Strategy::Mis, !last || !emission.is_empty(), s);
+                let (direct, next) = env_direct(bvh, env, &sh, Strategy::Mis, !last || emitters.is_some(), s);
                 l += beta * direct;
                 next
             }
             None => brdf_continuation(bvh, &sh, s),
         };
-        let Some(Continuation { dir: wi, weight, hit: Some(hit) }) = next else { break };
+        let Some(Continuation { dir: wi, weight, pdf, hit: Some(hit) }) = next else { break };
         beta *= weight;
-        l += beta * emitted(&hit);
+        let le = emitted(&hit);
+        if le != Vec3::ZERO
+            && let Some(e) = emitters
+        {
+            // the emitter sample could have drawn this point too
+            let cos = hit.geometric_normal.dot(wi).abs().max(1e-12);
+            let light_pdf = e.pdf_area(hit.object) * hit.t * hit.t / cos;
+            l += beta * le * power_heuristic(pdf, light_pdf);
+        }
         if last {
             break;
         }
@@ -434,6 +450,34 @@ fn path(
     l
 }
 
+/// Next-event estimation towards a point of an emitter, MIS-weighted against the BRDF sample.
+fn emitter_direct(bvh: &SceneBvh, emitters: &Emitters, sh: &Shading, s: &mut PixelSampler) -> Vec3 {
+    let (u, uv) = (s.next_1d(), s.next_2d());
+    let Some((y, n, le, pdf_area)) = emitters.sample(u, uv) else { return Vec3::ZERO };
+    let origin = sh.origin();
+    let to = y - origin;
+    let dist = to.length();
+    if dist <= 0.0 || pdf_area <= 0.0 {
+        return Vec3::ZERO;
+    }
+    let wi = to / dist;
+    // one-sided: the point must see the emitter's front
+    let cos_light = -n.dot(wi);
+    if cos_light <= 0.0 {
+        return Vec3::ZERO;
+    }
+    let (fc, wi_local) = sh.f_cos(wi);
+    if fc == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    let pdf = pdf_area * dist * dist / cos_light;
+    let t_max = (dist - 2.0 * bvh.epsilon()).max(0.0);
+    if bvh.occluded(origin, wi, t_max) {
+        return Vec3::ZERO;
+    }
+    fc * le * (power_heuristic(pdf, sh.material.brdf_pdf(sh.wo, wi_local)) / pdf)
+}
+
 /// A BRDF-sampled continuation without a map (emitters only), traced to its hit.
 fn brdf_continuation(bvh: &SceneBvh, sh: &Shading, s: &mut PixelSampler) -> Option<Continuation> {
     let (u_brdf, u_lobe) = (s.next_2d(), s.next_1d());
@@ -443,6 +487,7 @@ fn brdf_continuation(bvh: &SceneBvh, sh: &Shading, s: &mut PixelSampler) -> Opti
     (fc != Vec3::ZERO && pdf > 0.0).then(|| Continuation {
         dir: wi_world,
         weight: fc / pdf,
+        pdf,
         hit: bvh.intersect(sh.origin(), wi_world, f32::INFINITY),
     })
 }

@@ -27,6 +27,7 @@
 //! Architecture invariant: never depends on wgpu.
 
 mod bvh;
+mod emitters;
 mod integrator;
 pub mod metrics;
 mod render;
@@ -34,6 +35,7 @@ pub mod sampler;
 pub mod visibility;
 
 pub use bvh::{SceneBvh, SurfacePoint};
+pub use emitters::Emitters;
 pub use integrator::{AmbientMap, EnvLight, Integrator, LightSet, Strategy};
 pub use render::{Render, RenderSettings, render};
 pub use sampler::SamplerKind;
