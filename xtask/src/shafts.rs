@@ -143,6 +143,7 @@ pub fn run(args: &ShaftsArgs) -> Result<(), String> {
             "hits_in_pruned_shafts": c.in_pruned,
             "true_occluders_found": c.found as f64 / c.true_occluders.max(1) as f64,
             "sources_reported_per_frame": c.reported as f64 / FRAMES as f64,
+            "reported_unconfirmed": c.unconfirmed as f64 / c.reported.max(1) as f64,
             "shafts": h.shafts.len(),
             "transfer_bytes": h.transfer_bytes(),
             "source_power_share": prepared.power.0 / prepared.power.1.max(f64::MIN_POSITIVE),
@@ -167,12 +168,14 @@ pub fn run(args: &ShaftsArgs) -> Result<(), String> {
             c.reported as f64 / FRAMES as f64
         ));
         say(&format!(
-            "check: {} segments, {} meet the object, {} misses, {} in pruned shafts; {:.1} % of the true occluders found",
+            "check: {} segments, {} meet the object, {} misses, {} in pruned shafts; {:.1} % of the true occluders found; {:.1} % of the reported sources unconfirmed by {} segments each (false positives at most)",
             c.segments,
             c.hits,
             c.misses,
             c.in_pruned,
-            100.0 * c.found as f64 / c.true_occluders.max(1) as f64
+            100.0 * c.found as f64 / c.true_occluders.max(1) as f64,
+            100.0 * c.unconfirmed as f64 / c.reported.max(1) as f64,
+            shaft_hierarchy::measure::CONFIRM_SEGMENTS
         ));
         say(&format!("wrote {}", png.display()));
     }

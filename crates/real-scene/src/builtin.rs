@@ -191,9 +191,17 @@ mod tests {
                 assert!(p.area() > 1e-4 && (p.normal().length() - 1.0).abs() < 1e-4, "{name}: {p:?}");
                 assert!(p.reflectance.max_element() < 1.0 && p.reflectance.min_element() >= 0.0);
             }
-            // coarser reconstructions have fewer patches
+            // coarser reconstructions have fewer patches, covering the same area
             let coarse = RealScene::builtin_with(name, &Perturbation { coarsen: 2, ..Perturbation::NONE }).unwrap();
             assert!(coarse.patches.len() * 2 < s.patches.len(), "{name}");
+            let area = |s: &RealScene| s.patches.iter().map(Patch::area).sum::<f32>();
+            assert!((area(&coarse) / area(&s) - 1.0).abs() < 1e-4, "{name}");
+            // darker ones scale every reflectance, emission untouched
+            let dark =
+                RealScene::builtin_with(name, &Perturbation { reflectance_scale: 0.8, ..Perturbation::NONE }).unwrap();
+            for (d, p) in dark.patches.iter().zip(&s.patches) {
+                assert!((d.reflectance - p.reflectance * 0.8).abs().max_element() < 1e-6 && d.emission == p.emission);
+            }
         }
         assert!(matches!(RealScene::builtin("nope"), Err(RealSceneError::Unknown(_))));
     }

@@ -52,7 +52,13 @@ pub struct Check {
     pub found: usize,
     /// Sources reported, summed over frames.
     pub reported: usize,
+    /// Reported sources none of whose [`CONFIRM_SEGMENTS`] segments to the receivers of their
+    /// met leaf shafts meets the object: the false positives, as far as sampling tells.
+    pub unconfirmed: usize,
 }
+
+/// Segments drawn per reported source to confirm it.
+pub const CONFIRM_SEGMENTS: usize = 64;
 
 /// A point of source `s` for a segment from receiver point `x` (a distant light's: `reach` along
 /// a direction in its cone).
@@ -133,6 +139,20 @@ pub fn check(
         c.true_occluders += occluders.len();
         c.found += occluders.iter().filter(|j| reported.contains(j)).count();
         c.reported += o.sources.len();
+        // false positives: a reported source that no segment to its reported receivers meets
+        let mut receivers_of: std::collections::HashMap<u32, Vec<u32>> = std::collections::HashMap::new();
+        for &(j, p) in &kept {
+            receivers_of.entry(j).or_default().push(p);
+        }
+        for (&j, rs) in &receivers_of {
+            let confirmed = (0..CONFIRM_SEGMENTS).any(|_| {
+                let r = rs[rng.random_range(0..rs.len())];
+                let x = scene.patches[prepared.receivers[r as usize] as usize].point(rng.random(), rng.random());
+                let y = source_point(scene, lights, prepared.sources[j as usize], x, h.reach(), &mut rng);
+                object.segment_hits(x, y)
+            });
+            c.unconfirmed += usize::from(!confirmed);
+        }
     }
     c
 }
