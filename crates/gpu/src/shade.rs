@@ -326,24 +326,3 @@ impl Background {
         Ok(Self { texture, size: (w, h) })
     }
 }
-
-/// Box-filters an image rendered at `factor` × `factor` samples per pixel (`width` ×
-/// `height` output pixels, row-major) down to one value per pixel: supersampling, the same
-/// pixel filter as `ref-tracer`'s jittered samples.
-///
-/// # Panics
-/// When `image` does not hold `width × factor` × `height × factor` values.
-#[must_use]
-pub fn downsample_box(image: &[Vec3], (width, height): (u32, u32), factor: u32) -> Vec<Vec3> {
-    let f = factor.max(1) as usize;
-    let (w, h) = (width as usize, height as usize);
-    assert_eq!(image.len(), w * f * h * f, "a {w}x{h} image at {f}x{f} samples");
-    let mut out = vec![Vec3::ZERO; w * h];
-    let scale = 1.0 / (f * f) as f32;
-    for (y, row) in image.chunks_exact(w * f).enumerate() {
-        for (x, v) in row.iter().enumerate() {
-            out[(y / f) * w + x / f] += *v * scale;
-        }
-    }
-    out
-}
