@@ -66,11 +66,8 @@ impl Patch {
     }
 }
 
-/// Rec. 709 luminance of linear RGB.
-#[must_use]
-pub fn luminance(c: Vec3) -> f32 {
-    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
-}
+/// Rec. 709 luminance of linear RGB (the project's one definition).
+pub use envmap_sphere::luminance;
 
 /// The reconstructed scene: patches and the camera that took the photograph.
 #[derive(Clone, Debug, PartialEq)]

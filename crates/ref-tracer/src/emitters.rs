@@ -2,6 +2,7 @@
 //! (luminance of the emitted radiance x area) and sampled uniformly by area, for next-event
 //! estimation combined by MIS with the BRDF samples that hit them.
 
+use envmap_sphere::luminance;
 use glam::{Vec2, Vec3};
 use scene::Scene;
 
@@ -26,10 +27,6 @@ pub struct Emitters {
     cdf: Vec<f32>,
     /// Σ luminance(Le) x area over the emitting triangles.
     total: f32,
-}
-
-fn luminance(c: Vec3) -> f32 {
-    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
 }
 
 impl Emitters {

@@ -285,13 +285,7 @@ impl ShaftHierarchy {
             let ShaftNode { source, receiver, .. } = self.shafts[k];
             let (s, r) = (self.source_tree.nodes[source as usize], self.receiver_tree.nodes[receiver as usize]);
             if s.is_leaf() && r.is_leaf() {
-                let sum = self
-                    .receiver_tree
-                    .items(receiver)
-                    .iter()
-                    .flat_map(|&p| self.receivers[p as usize].slots.clone())
-                    .map(|i| self.node_transfer(source, i))
-                    .sum();
+                let sum = self.pair_transfer(source, receiver) as f32;
                 self.shafts[k].kind = Kind::Leaf;
                 self.shafts[k].child = self.leaf_transfer.len() as u32;
                 self.leaf_transfer.push(sum);
@@ -300,11 +294,8 @@ impl ShaftHierarchy {
             }
             let split_source =
                 !s.is_leaf() && (r.is_leaf() || self.source_size(source, &r) >= r.bounds.size().length());
-            let pairs: Vec<(u32, u32)> = if split_source {
-                self.source_tree.children(source).map(|c| (c, receiver)).collect()
-            } else {
-                self.receiver_tree.children(receiver).map(|c| (source, c)).collect()
-            };
+            self.shafts[k].kind = if split_source { Kind::SplitSource } else { Kind::SplitReceiver };
+            let pairs = self.child_pairs(&self.shafts[k]);
             let child = self.shafts.len() as u32;
             let mut pruned = 0u8;
             for (c, &(cs, cr)) in pairs.iter().enumerate() {
@@ -323,12 +314,21 @@ impl ShaftHierarchy {
             }
             let children = (self.shafts.len() as u32 - child) as u8;
             let node = &mut self.shafts[k];
-            node.kind = if split_source { Kind::SplitSource } else { Kind::SplitReceiver };
             node.child = child;
             node.children = children;
             node.pruned = pruned;
             k += 1;
         }
+    }
+
+    /// A pair's summed transfer: the source node's to every vertex of the receiver node.
+    fn pair_transfer(&self, source: u32, receiver: u32) -> f64 {
+        self.receiver_tree
+            .items(receiver)
+            .iter()
+            .flat_map(|&p| self.receivers[p as usize].slots.clone())
+            .map(|i| f64::from(self.node_transfer(source, i)))
+            .sum()
     }
 
     /// The (source node, receiver node) pairs a split node's tree children make, in order.
@@ -477,13 +477,7 @@ impl ShaftHierarchy {
                 if n.child as usize != leaves {
                     return Err(format!("leaf shaft {k}: transfer index {} out of order", n.child));
                 }
-                let sum: f64 = self
-                    .receiver_tree
-                    .items(n.receiver)
-                    .iter()
-                    .flat_map(|&p| self.receivers[p as usize].slots.clone())
-                    .map(|i| f64::from(self.node_transfer(n.source, i)))
-                    .sum();
+                let sum = self.pair_transfer(n.source, n.receiver);
                 let stored = f64::from(self.leaf_transfer[leaves]);
                 if (sum - stored).abs() > 1e-4 * sum.abs().max(1e-30) {
                     return Err(format!("leaf shaft {k}: stored transfer {stored}, summed {sum}"));

@@ -140,10 +140,12 @@ pub fn check(
         c.found += occluders.iter().filter(|j| reported.contains(j)).count();
         c.reported += o.sources.len();
         // false positives: a reported source that no segment to its reported receivers meets
-        let mut receivers_of: std::collections::HashMap<u32, Vec<u32>> = std::collections::HashMap::new();
+        // in a fixed order, so that the seed fixes the segments
+        let mut receivers_of: std::collections::BTreeMap<u32, Vec<u32>> = std::collections::BTreeMap::new();
         for &(j, p) in &kept {
             receivers_of.entry(j).or_default().push(p);
         }
+        receivers_of.values_mut().for_each(|rs| rs.sort_unstable());
         for (&j, rs) in &receivers_of {
             let confirmed = (0..CONFIRM_SEGMENTS).any(|_| {
                 let r = rs[rng.random_range(0..rs.len())];

@@ -35,54 +35,64 @@ pub struct Shaft {
     count: u8,
 }
 
-/// Which box defines a face of the joint box.
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum Owner {
-    A,
-    B,
-    Both,
-}
+/// An edge of the joint box whose two faces come from different boxes: its two axes (i, j),
+/// the matching edge of `a` and of `b`, and the joint box's corner, all in (i, j).
+type JoiningEdge = (usize, usize, [f32; 2], [f32; 2], [f32; 2]);
 
-/// The edges of the joint box whose two faces come from different boxes: per edge, its two
-/// axes (i, j), the matching edge of `a` and of `b`, and the joint box's corner, all in (i, j).
-fn joining_edges(a: &Aabb, b: &Aabb) -> impl Iterator<Item = (usize, usize, [f32; 2], [f32; 2], [f32; 2])> {
-    let (a, b) = (*a, *b);
-    let extent = a.union(&b);
-    let owner = move |axis: usize, max: bool| {
-        let (x, y) = if max { (a.max[axis], b.max[axis]) } else { (a.min[axis], b.min[axis]) };
-        match x.partial_cmp(&y) {
-            Some(std::cmp::Ordering::Greater) => {
-                if max {
-                    Owner::A
-                } else {
-                    Owner::B
-                }
-            }
-            Some(std::cmp::Ordering::Less) => {
-                if max {
-                    Owner::B
-                } else {
-                    Owner::A
-                }
-            }
-            _ => Owner::Both,
+/// Which box defines each face of the joint box of `a` and `b`, per axis, for the min and the
+/// max faces: +1 `a`, -1 `b`, 0 both.
+#[inline]
+fn face_owners(a: &Aabb, b: &Aabb) -> ([i8; 3], [i8; 3]) {
+    let owner = |x: f32, y: f32, max: bool| -> i8 {
+        if x == y {
+            0
+        } else if (x > y) == max {
+            1
+        } else {
+            -1
         }
     };
-    let side = |bx: &Aabb, axis: usize, max: bool| if max { bx.max[axis] } else { bx.min[axis] };
-    [(0, 1), (1, 2), (2, 0)].into_iter().flat_map(move |(i, j)| {
-        [(false, false), (false, true), (true, false), (true, true)].into_iter().filter_map(move |(max_i, max_j)| {
-            let (oi, oj) = (owner(i, max_i), owner(j, max_j));
-            (oi != oj && oi != Owner::Both && oj != Owner::Both).then(|| {
-                (
-                    i,
-                    j,
-                    [side(&a, i, max_i), side(&a, j, max_j)],
-                    [side(&b, i, max_i), side(&b, j, max_j)],
-                    [side(&extent, i, max_i), side(&extent, j, max_j)],
-                )
-            })
+    let (mut lo, mut hi) = ([0i8; 3], [0i8; 3]);
+    for k in 0..3 {
+        lo[k] = owner(a.min[k], b.min[k], false);
+        hi[k] = owner(a.max[k], b.max[k], true);
+    }
+    (lo, hi)
+}
+
+/// The 12 edges of a joint box: axis pairs and corners (max on axis i, max on axis j).
+const EDGES: [(usize, usize, bool, bool); 12] = {
+    let mut e = [(0, 0, false, false); 12];
+    let pairs = [(0, 1), (1, 2), (2, 0)];
+    let mut k = 0;
+    while k < 12 {
+        e[k] = (pairs[k / 4].0, pairs[k / 4].1, k & 2 != 0, k & 1 != 0);
+        k += 1;
+    }
+    e
+};
+
+/// The joining edges of `a` and `b` (at most 8 of the 12).
+fn joining_edges(a: &Aabb, b: &Aabb) -> Vec<JoiningEdge> {
+    let extent = a.union(b);
+    let (lo, hi) = face_owners(a, b);
+    let pick = |bx: &Aabb, k: usize, max: bool| if max { bx.max[k] } else { bx.min[k] };
+    EDGES
+        .iter()
+        .filter(|&&(i, j, max_i, max_j)| {
+            let (oi, oj) = (if max_i { hi[i] } else { lo[i] }, if max_j { hi[j] } else { lo[j] });
+            oi != 0 && oj != 0 && oi != oj
         })
-    })
+        .map(|&(i, j, max_i, max_j)| {
+            (
+                i,
+                j,
+                [pick(a, i, max_i), pick(a, j, max_j)],
+                [pick(b, i, max_i), pick(b, j, max_j)],
+                [pick(&extent, i, max_i), pick(&extent, j, max_j)],
+            )
+        })
+        .collect()
 }
 
 /// How an object's box meets a shaft, as [`meets`] answers.
@@ -108,48 +118,33 @@ pub fn meets(a: &Aabb, b: &Aabb, object: &Aabb) -> Meet {
     if object.contains(&extent) {
         return Meet::Covers;
     }
-    // which box defines each face of the joint box: +1 a, -1 b, 0 both
-    let owner = |x: f32, y: f32, max: bool| -> i8 {
-        if x == y {
-            0
-        } else if (x > y) == max {
-            1
-        } else {
-            -1
+    // the planes written out here, not through `joining_edges`: traversal's hot path, and a
+    // hand-written iterator over the edges measured 28 % slower per frame (ar_room, no pruning)
+    let (lo, hi) = face_owners(a, b);
+    for &(i, j, max_i, max_j) in &EDGES {
+        let oi = if max_i { hi[i] } else { lo[i] };
+        let oj = if max_j { hi[j] } else { lo[j] };
+        if oi == 0 || oj == 0 || oi == oj {
+            continue;
         }
-    };
-    let mut lo = [0i8; 3];
-    let mut hi = [0i8; 3];
-    for k in 0..3 {
-        lo[k] = owner(a.min[k], b.min[k], false);
-        hi[k] = owner(a.max[k], b.max[k], true);
-    }
-    for (i, j) in [(0usize, 1usize), (1, 2), (2, 0)] {
-        for (max_i, max_j) in [(false, false), (false, true), (true, false), (true, true)] {
-            let oi = if max_i { hi[i] } else { lo[i] };
-            let oj = if max_j { hi[j] } else { lo[j] };
-            if oi == 0 || oj == 0 || oi == oj {
-                continue;
-            }
-            let pick = |bx: &Aabb, k: usize, max: bool| if max { bx.max[k] } else { bx.min[k] };
-            let pa = [pick(a, i, max_i), pick(a, j, max_j)];
-            let pb = [pick(b, i, max_i), pick(b, j, max_j)];
-            let corner = [pick(&extent, i, max_i), pick(&extent, j, max_j)];
-            let mut n = [pb[1] - pa[1], pa[0] - pb[0]];
-            if n[0] * (corner[0] - pa[0]) + n[1] * (corner[1] - pa[1]) < 0.0 {
-                n = [-n[0], -n[1]];
-            }
-            let near = [
-                if n[0] > 0.0 { object.min[i] } else { object.max[i] },
-                if n[1] > 0.0 { object.min[j] } else { object.max[j] },
-            ];
-            let offset = (n[0] * pa[0] + n[1] * pa[1]).max(n[0] * pb[0] + n[1] * pb[1]);
-            // f32 rounding of every product here: outward by more than it can be
-            let scale = n[0].abs() * pa[0].abs().max(pb[0].abs()).max(near[0].abs())
-                + n[1].abs() * pa[1].abs().max(pb[1].abs()).max(near[1].abs());
-            if n[0] * near[0] + n[1] * near[1] > offset + 16.0 * f32::EPSILON * scale {
-                return Meet::Outside;
-            }
+        let pick = |bx: &Aabb, k: usize, max: bool| if max { bx.max[k] } else { bx.min[k] };
+        let pa = [pick(a, i, max_i), pick(a, j, max_j)];
+        let pb = [pick(b, i, max_i), pick(b, j, max_j)];
+        let corner = [pick(&extent, i, max_i), pick(&extent, j, max_j)];
+        let mut n = [pb[1] - pa[1], pa[0] - pb[0]];
+        if n[0] * (corner[0] - pa[0]) + n[1] * (corner[1] - pa[1]) < 0.0 {
+            n = [-n[0], -n[1]];
+        }
+        let near = [
+            if n[0] > 0.0 { object.min[i] } else { object.max[i] },
+            if n[1] > 0.0 { object.min[j] } else { object.max[j] },
+        ];
+        let offset = (n[0] * pa[0] + n[1] * pa[1]).max(n[0] * pb[0] + n[1] * pb[1]);
+        // f32 rounding of every product here: outward by more than it can be
+        let scale = n[0].abs() * pa[0].abs().max(pb[0].abs()).max(near[0].abs())
+            + n[1].abs() * pa[1].abs().max(pb[1].abs()).max(near[1].abs());
+        if n[0] * near[0] + n[1] * near[1] > offset + 16.0 * f32::EPSILON * scale {
+            return Meet::Outside;
         }
     }
     Meet::Partial
