@@ -4,6 +4,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use envmap_sphere::EnvMap;
+use envshadow_benches::ok;
 use glam::Vec3;
 use light_extract::{
     CenterSurround, EmissiveSplit, ImportanceSampled, LightExtractor, MedianCut, VarianceMinimization,
@@ -31,22 +32,28 @@ fn discs(n: usize, cos_r: f32) -> EnvMap {
 
 fn extract(c: &mut Criterion) {
     let map = envshadow_benches::bench_map();
-    c.bench_function("median_cut_32_1024x512", |b| b.iter(|| MedianCut::with_lights(32).extract(black_box(&map))));
-    c.bench_function("variance_min_32_1024x512", |b| {
-        b.iter(|| VarianceMinimization::with_lights(32).extract(black_box(&map)))
+    c.bench_function("median_cut_32_1024x512", |b| {
+        b.iter(|| ok(MedianCut::with_lights(32).extract(black_box(&map)).map(|d| d.lights.len())))
     });
-    c.bench_function("emissive_split_32_1024x512", |b| b.iter(|| EmissiveSplit::default().extract(black_box(&map))));
-    c.bench_function("center_surround_1024x512", |b| b.iter(|| CenterSurround::default().extract(black_box(&map))));
+    c.bench_function("variance_min_32_1024x512", |b| {
+        b.iter(|| ok(VarianceMinimization::with_lights(32).extract(black_box(&map)).map(|d| d.lights.len())))
+    });
+    c.bench_function("emissive_split_32_1024x512", |b| {
+        b.iter(|| ok(EmissiveSplit::default().extract(black_box(&map)).map(|d| d.lights.len())))
+    });
+    c.bench_function("center_surround_1024x512", |b| {
+        b.iter(|| ok(CenterSurround::default().extract(black_box(&map)).map(|d| d.lights.len())))
+    });
     let flat_with_pole_sun = EnvMap::from_texels(1024, 512, |_, j| Vec3::splat(if j < 2 { 300.0 } else { 0.5 }));
     c.bench_function("center_surround_flat_pole_sun_1024x512", |b| {
-        b.iter(|| CenterSurround::default().extract(black_box(&flat_with_pole_sun)))
+        b.iter(|| ok(CenterSurround::default().extract(black_box(&flat_with_pole_sun)).map(|d| d.lights.len())))
     });
     let wide = discs(64, 0.99);
     c.bench_function("center_surround_64_wide_discs_1024x512", |b| {
-        b.iter(|| CenterSurround::default().extract(black_box(&wide)))
+        b.iter(|| ok(CenterSurround::default().extract(black_box(&wide)).map(|d| d.lights.len())))
     });
     c.bench_function("importance_32_1024x512", |b| {
-        b.iter(|| ImportanceSampled { count: 32, seed: 0 }.extract(black_box(&map)))
+        b.iter(|| ok(ImportanceSampled { count: 32, seed: 0 }.extract(black_box(&map)).map(|d| d.lights.len())))
     });
 }
 

@@ -6,7 +6,6 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use gpu::{Gpu, ShadowGeometry, scene_triangles};
 use shadowmap_paraboloid::{ShadowLight, ShadowMapper, equal_texel_variants, shadow_triangles};
-use std::time::Duration;
 
 fn shadow_maps(c: &mut Criterion) {
     let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
@@ -23,9 +22,7 @@ fn shadow_maps(c: &mut Criterion) {
             b.iter_custom(|iters| {
                 (0..iters)
                     .map(|_| {
-                        mapper
-                            .render(&gpu, &geometry, &light, v.technique, &v.settings)
-                            .map_or(Duration::MAX, |m| m.time)
+                        envshadow_benches::ok(mapper.render(&gpu, &geometry, &light, v.technique, &v.settings)).time
                     })
                     .sum()
             });

@@ -18,8 +18,9 @@ fn shafts(c: &mut Criterion) {
     let settings = PreprocessSettings::PAPER;
     let mut group = c.benchmark_group(format!("shafts_{}_patches", scene.patches.len()));
     group.sample_size(10);
-    group
-        .bench_function("preprocess", |b| b.iter(|| build(&scene, &[], &bvh, &settings).map(|(_, h)| h.leaf_shafts())));
+    group.bench_function("preprocess", |b| {
+        b.iter(|| envshadow_benches::ok(build(&scene, &[], &bvh, &settings)).1.leaf_shafts())
+    });
     let (_, h) = build(&scene, &[], &bvh, &settings).unwrap_or_else(|e| panic!("{e}"));
     let objects = object_path(&scene, 240);
     let mut scratch = Traversal::default();

@@ -6,7 +6,6 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use envshadow_benches::soft_shadows::{Frame, entries, light};
 use gpu::Gpu;
-use std::time::Duration;
 
 fn soft_shadows(c: &mut Criterion) {
     let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
@@ -19,9 +18,7 @@ fn soft_shadows(c: &mut Criterion) {
             group.bench_function(e.technique.name(), |b| {
                 b.iter_custom(|iters| {
                     (0..iters)
-                        .map(|_| {
-                            frame.visibility(&gpu, e.technique.as_ref(), &l).map_or(Duration::MAX, |(_, r)| r.time)
-                        })
+                        .map(|_| envshadow_benches::ok(frame.visibility(&gpu, e.technique.as_ref(), &l)).1.time)
                         .sum()
                 });
             });

@@ -12,3 +12,13 @@ use envmap_sphere::EnvMap;
 pub fn bench_map() -> EnvMap {
     envmap_sphere::default_map()
 }
+
+/// The value of a benchmarked call that must not fail: an error panics, so a bench whose work
+/// errors fails its smoke run in `cargo xtask test` instead of timing the error path.
+///
+/// # Panics
+/// When `r` is an error, with its message.
+#[track_caller]
+pub fn ok<T, E: std::fmt::Display>(r: Result<T, E>) -> T {
+    r.unwrap_or_else(|e| panic!("bench input failed: {e}"))
+}

@@ -70,3 +70,30 @@ fn nothing_reads_beside_the_repository() {
         .collect();
     assert!(hits.is_empty(), "files that read {beside}:\n{}", hits.join("\n"));
 }
+
+#[test]
+fn library_errors_are_typed() {
+    // docs/architecture.md, "Errors": a public function of a library crate returns a thiserror
+    // enum, not a String, except the `validate()` consistency checks. Signatures are read from
+    // the `pub fn` line through its opening brace.
+    let root = workspace_root();
+    let mut sources = Vec::new();
+    workspace_tests::collect(&root.join("crates"), "rs", &mut sources);
+    let mut hits = Vec::new();
+    for p in sources.iter().filter(|p| p.components().any(|c| c.as_os_str() == "src")) {
+        let text = std::fs::read_to_string(p).unwrap_or_default();
+        let lines: Vec<&str> = text.lines().collect();
+        for (n, line) in lines.iter().enumerate() {
+            let t = line.trim_start();
+            if !t.starts_with("pub fn ") || t.starts_with("pub fn validate(") {
+                continue;
+            }
+            let end = lines[n..].iter().position(|l| l.trim_end().ends_with('{') || l.trim_end().ends_with(';'));
+            let signature = lines[n..=n + end.unwrap_or(0)].concat();
+            if signature.contains(", String>") {
+                hits.push(format!("{}:{}: {}", p.display(), n + 1, t));
+            }
+        }
+    }
+    assert!(hits.is_empty(), "String errors from library functions:\n{}", hits.join("\n"));
+}

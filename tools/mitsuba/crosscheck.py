@@ -1,11 +1,18 @@
 #!/usr/bin/env python3
 """Cross-check ref-tracer against Mitsuba 3 (an independent renderer) on a Lambertian built-in scene.
 
-Exports the scene with `cargo xtask scene NAME --obj`, renders it with Mitsuba's `direct`
-integrator (one emitter sample and one BSDF sample per pixel sample, as `env-direct`), renders it
-with `cargo xtask render`, and prints RMSE / FLIP (`cargo xtask compare`), the mean ratio per
-channel, and Mitsuba's samples per second. Run it through `tools/mitsuba/crosscheck.sh`, which
-makes the Python environment. Not part of CI: it needs PyPI and a libLLVM >= 17.
+Exports the scene with `cargo xtask scene NAME --obj`, renders it with Mitsuba and with
+`cargo xtask render`, and prints RMSE / FLIP (`cargo xtask compare`) of ours against Mitsuba's,
+Mitsuba's own noise (the same comparison between two Mitsuba renders of different seeds), the
+mean ratio per channel, and Mitsuba's samples per second.
+
+`--integrator direct` (default) compares `env-direct` with Mitsuba's `direct` (one emitter and one
+BSDF sample per pixel sample). `--integrator path --max-depth D` compares our `path`, whose D
+counts scattering events (D = 1: direct light only), with Mitsuba's `path` at max_depth D + 1:
+Mitsuba's depth counts the camera segment too (1 renders only the emitters seen directly).
+
+Run it through `tools/mitsuba/crosscheck.sh`, which makes the Python environment. Not part of CI:
+it needs PyPI and a libLLVM >= 17.
 """
 
 import argparse
@@ -78,7 +85,11 @@ def main():
     ap.add_argument("--spp", type=int, default=256)
     ap.add_argument("--size", default=None, help="WIDTHxHEIGHT (default: the scene's camera)")
     ap.add_argument("--out", default="target/crosscheck")
+    ap.add_argument("--integrator", choices=["direct", "path"], default="direct")
+    ap.add_argument("--max-depth", type=int, default=3, help="scattering events for --integrator path (ours)")
     args = ap.parse_args()
+    if args.max_depth < 1:
+        sys.exit("--max-depth must be at least 1")
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     obj = out / f"{args.scene}.obj"
@@ -92,7 +103,12 @@ def main():
     mi.set_variant("llvm_ad_rgb")
     scene = {
         "type": "scene",
-        "integrator": {"type": "direct", "emitter_samples": 1, "bsdf_samples": 1},
+        "integrator": (
+            {"type": "direct", "emitter_samples": 1, "bsdf_samples": 1}
+            if args.integrator == "direct"
+            # Mitsuba's max_depth counts the camera segment: ours + 1
+            else {"type": "path", "max_depth": args.max_depth + 1}
+        ),
         "sensor": {
             "type": "perspective", "fov": hfov, "fov_axis": "x",
             "to_world": mi.ScalarTransform4f().look_at(origin=eye, target=target, up=up),
@@ -112,16 +128,26 @@ def main():
     seconds = time.time() - start
     mitsuba_exr = out / "mitsuba.exr"
     mi.Bitmap(image).write(str(mitsuba_exr))
+    # a second Mitsuba render, another seed: the noise of one render at this count
+    mitsuba2_exr = out / "mitsuba_seed2.exr"
+    mi.Bitmap(np.array(mi.render(scene, spp=args.spp, seed=2))).write(str(mitsuba2_exr))
 
     ours_exr = out / "ours.exr"
+    ours_integrator = ["--integrator", "env-direct"] if args.integrator == "direct" else [
+        "--integrator", "path", "--max-depth", str(args.max_depth)]
     subprocess.run(xtask + ["render", "--scene", args.scene, "--envmap", args.envmap, "--spp", str(args.spp),
-                            "--size", f"{w}x{h}", "--seed", "1", "--out", str(ours_exr)], check=True)
+                            "--size", f"{w}x{h}", "--seed", "1", "--out", str(ours_exr)] + ours_integrator,
+                   check=True)
     ours = np.array(mi.Bitmap(str(ours_exr)))[:, :, :3]
     ratio = image[:, :, :3].reshape(-1, 3).mean(axis=0) / ours.reshape(-1, 3).mean(axis=0)
-    print(f"mitsuba 3 {mi.__version__} llvm_ad_rgb, direct, independent: {w}x{h} {args.spp} spp in {seconds:.2f} s, "
+    what = "direct" if args.integrator == "direct" else f"path max_depth {args.max_depth + 1} (ours {args.max_depth})"
+    print(f"mitsuba 3 {mi.__version__} llvm_ad_rgb, {what}, independent: {w}x{h} {args.spp} spp in {seconds:.2f} s, "
           f"{w * h * args.spp / seconds / 1e6:.2f} M samples/s")
     print(f"mean mitsuba / ours per channel: {ratio[0]:.4f} {ratio[1]:.4f} {ratio[2]:.4f}")
+    print("ours against mitsuba (seed 1):", flush=True)
     subprocess.run(xtask + ["compare", str(mitsuba_exr), str(ours_exr)], check=True)
+    print("mitsuba's own noise, seed 2 against seed 1:", flush=True)
+    subprocess.run(xtask + ["compare", str(mitsuba_exr), str(mitsuba2_exr)], check=True)
 
 
 if __name__ == "__main__":

@@ -15,10 +15,11 @@ find_llvm() {
 }
 llvm=${DRJIT_LIBLLVM_PATH:-$(find_llvm || true)}
 if [ -z "$llvm" ]; then
+  # a fresh machine's package lists may be empty or old: update them first
   if command -v apt-get >/dev/null && [ "$(id -u)" = 0 ]; then
-    apt-get install -y -q libllvm19 >/dev/null
+    apt-get update -qq && apt-get install -y -q libllvm19 >/dev/null
   elif command -v apt-get >/dev/null; then
-    sudo apt-get install -y -q libllvm19 >/dev/null
+    sudo apt-get update -qq && sudo apt-get install -y -q libllvm19 >/dev/null
   fi
   llvm=$(find_llvm || true)
 fi

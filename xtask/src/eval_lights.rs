@@ -83,7 +83,7 @@ fn methods(k: usize) -> Vec<Method> {
 }
 
 pub fn run(args: &EvalArgs) -> Result<(), String> {
-    let maps = envmap_sphere::test_set::maps_in(&args.maps)?;
+    let maps = envmap_sphere::test_set::maps_in(&args.maps).map_err(|e| e.to_string())?;
     if maps.is_empty() {
         return Err(format!("{}: no .exr or .hdr maps", args.maps.display()));
     }

@@ -18,8 +18,8 @@ pub fn run(path: &Path, method: &str, k: usize, out: Option<&Path>, lux_per_unit
     let stem = path.file_stem().map_or_else(|| "map".into(), |s| s.to_string_lossy().to_string());
     let dir = out.map_or_else(|| Path::new("target/extract").join(format!("{stem}-{method}")), Path::to_path_buf);
     // paper 001, section 3.5: 8 sets, directions perturbed within 0.1 x the cluster extent
-    d.write(&dir, &d.interleaved(), lux_per_unit)?;
-    light_extract::overlay::write_overlay(&dir.join("overlay.png"), &map, &d.lights)?;
+    d.write(&dir, &d.interleaved(), lux_per_unit).map_err(|e| e.to_string())?;
+    light_extract::overlay::write_overlay(&dir.join("overlay.png"), &map, &d.lights).map_err(|e| e.to_string())?;
     for (k, l) in d.lights.iter().enumerate() {
         let (dir_, p) = (l.light.direction, l.power());
         outln!(

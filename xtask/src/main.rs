@@ -202,8 +202,16 @@ pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
     Ok((w.parse().map_err(|e| format!("width: {e}"))?, h.parse().map_err(|e| format!("height: {e}"))?))
 }
 
+/// Set, the command line is parsed (clap's checks: subcommand, options, values) and nothing is
+/// run: what the README's command-line test uses.
+const PARSE_ONLY_ENV: &str = "XTASK_PARSE_ONLY";
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if std::env::var_os(PARSE_ONLY_ENV).is_some() {
+        outln!("parsed");
+        return ExitCode::SUCCESS;
+    }
     let result = match cli.command {
         Command::Fuzz { cases, seed } => return fuzz::run(cases, seed),
         Command::Validate(args) => validate::run(&args),

@@ -73,7 +73,8 @@ pub fn run(args: &ShaftsArgs) -> Result<(), String> {
             "knob sweep: setting | sources | leaf shafts | bytes (per leaf) | pre-processing | traversal | true occluders found | misses",
         );
         for (name, settings) in sweep() {
-            let (f, _, _) = figures(&scene, &lights, &bvh, &settings, (FRAMES, SEGMENTS_PER_FRAME, REPRESENTATIVES))?;
+            let (f, _, _) = figures(&scene, &lights, &bvh, &settings, (FRAMES, SEGMENTS_PER_FRAME, REPRESENTATIVES))
+                .map_err(|e| e.to_string())?;
             let line = format!(
                 "| {name} | {} | {} | {} ({:.1}) | {:.2} s | {:.1} us | {:.1} % | {} |",
                 f.sources,
@@ -100,7 +101,8 @@ pub fn run(args: &ShaftsArgs) -> Result<(), String> {
         return Ok(());
     }
     let (f, prepared, h) =
-        figures(&scene, &lights, &bvh, &args.settings, (FRAMES, SEGMENTS_PER_FRAME, REPRESENTATIVES))?;
+        figures(&scene, &lights, &bvh, &args.settings, (FRAMES, SEGMENTS_PER_FRAME, REPRESENTATIVES))
+            .map_err(|e| e.to_string())?;
     let objects = object_path(&scene, FRAMES);
     let c = f.check;
     let (preprocess_s, traversal_us, bytes, leaf_shafts) = (f.preprocess_s, f.traversal_us, f.bytes, f.leaf_shafts);

@@ -7,6 +7,15 @@ fn xtask(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_xtask")).args(args).output().expect("run xtask")
 }
 
+/// An empty scratch folder for one test: cleared first, so a command that stopped writing its
+/// files cannot pass on what an earlier run left there.
+fn fresh_dir(name: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    dir
+}
+
 fn shared(name: &str) -> PathBuf {
     envmap_sphere::test_set::path(name)
 }
@@ -65,8 +74,7 @@ fn info_text_lists_the_statistics() {
 
 #[test]
 fn bad_input_exits_one_with_one_line_naming_the_file() {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli-bad");
-    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let dir = fresh_dir("cli-bad");
     let text = dir.join("text.hdr");
     std::fs::write(&text, "hello").expect("write");
     for path in [dir.join("missing.exr"), text] {
@@ -85,9 +93,7 @@ fn bad_input_exits_one_with_one_line_naming_the_file() {
 #[test]
 fn validate_quick_runs_from_a_copied_binary_and_meets_its_thresholds() {
     // a binary copied elsewhere, run from an empty folder: the thresholds are in the binary
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli-validate");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let dir = fresh_dir("cli-validate");
     let copy = dir.join("xtask-copy");
     std::fs::copy(env!("CARGO_BIN_EXE_xtask"), &copy).expect("copy the binary");
     let out =
@@ -130,8 +136,7 @@ fn an_unknown_adapter_exits_one_with_one_line_listing_the_adapters() {
 
 #[test]
 fn validate_reads_thresholds_from_a_file_and_refuses_a_broken_one() {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli-thresholds");
-    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let dir = fresh_dir("cli-thresholds");
     for (name, text, want) in [
         ("missing.json", None, "missing.json"),
         ("broken.json", Some("{\"thresholds\": {\"a\": \"x\"}}"), "threshold a is not a finite number"),
@@ -174,8 +179,7 @@ fn validate_refuses_an_unknown_scene_in_one_line() {
 
 #[test]
 fn scene_writes_obj_and_refuses_unknown_names() {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli-scene");
-    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let dir = fresh_dir("cli-scene");
     let obj = dir.join("spheres_box.obj");
     let out = xtask(&["scene", "spheres_box", "--obj", obj.to_str().unwrap_or_default()]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
@@ -190,8 +194,7 @@ fn scene_writes_obj_and_refuses_unknown_names() {
 
 #[test]
 fn render_writes_images_and_compare_reports_rmse_and_flip() {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli-render");
-    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let dir = fresh_dir("cli-render");
     let (a, b) = (dir.join("a.exr"), dir.join("b.exr"));
     let base = ["render", "--scene", "spheres_box", "--size", "64x48", "--spp", "4"];
     let out = xtask(&[&base[..], &["--seed", "1", "--aovs", "--out", a.to_str().unwrap_or_default()]].concat());
@@ -246,8 +249,7 @@ fn render_writes_images_and_compare_reports_rmse_and_flip() {
 
 #[test]
 fn render_with_lights_reads_the_light_extract_schema() {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli-lights");
-    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let dir = fresh_dir("cli-lights");
     let json = dir.join("lights.json");
     std::fs::write(
         &json,
@@ -261,6 +263,9 @@ fn render_with_lights_reads_the_light_extract_schema() {
             .concat(),
     );
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let img = envmap_sphere::EnvMap::load(&out_path).expect("the render is written");
+    assert!(img.pixels().iter().any(|p| p.max_element() > 0.0), "the light lit the scene");
+    std::fs::remove_file(&out_path).expect("remove");
     std::fs::write(&json, r#"{"lights": [{"direction": [0, 0, 0], "solid_angle": 0.1, "radiance": [1, 1, 1]}]}"#)
         .expect("write");
     let out = xtask(
@@ -270,6 +275,7 @@ fn render_with_lights_reads_the_light_extract_schema() {
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("lights.json") && err.contains("light 0"), "{err}");
+    assert!(!out_path.exists(), "nothing written after an error");
 }
 
 #[test]

@@ -28,12 +28,35 @@ pub fn path(name: &str) -> PathBuf {
     dir().join(name)
 }
 
+/// Why the test set's maps could not be listed; the message names the folder.
+#[derive(Debug, thiserror::Error)]
+pub enum TestSetError {
+    /// The folder cannot be read.
+    #[error("{}: {source}", path.display())]
+    Read {
+        /// The folder.
+        path: PathBuf,
+        /// The reason.
+        source: std::io::Error,
+    },
+    /// The folder holds fewer maps than the test set has.
+    #[error("{}: {found} maps, expected at least {wanted}", path.display())]
+    TooFew {
+        /// The folder.
+        path: PathBuf,
+        /// Maps found.
+        found: usize,
+        /// Maps wanted.
+        wanted: usize,
+    },
+}
+
 /// Every `.exr` and `.hdr` file in `dir`, sorted by name.
 ///
 /// # Errors
-/// A message naming the folder when it cannot be read.
-pub fn maps_in(dir: &Path) -> Result<Vec<PathBuf>, String> {
-    let entries = std::fs::read_dir(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+/// [`TestSetError::Read`] when the folder cannot be read.
+pub fn maps_in(dir: &Path) -> Result<Vec<PathBuf>, TestSetError> {
+    let entries = std::fs::read_dir(dir).map_err(|source| TestSetError::Read { path: dir.to_path_buf(), source })?;
     let mut maps: Vec<PathBuf> = entries
         .flatten()
         .map(|e| e.path())
@@ -46,15 +69,15 @@ pub fn maps_in(dir: &Path) -> Result<Vec<PathBuf>, String> {
 /// The test set's maps, sorted by name.
 ///
 /// # Errors
-/// A message naming the folder when it cannot be read or holds fewer than [`COUNT`] maps (tests
+/// [`TestSetError`] when the folder cannot be read or holds fewer than [`COUNT`] maps (tests
 /// that use them must fail, not pass vacuously; with `ENVSHADOW_ENVMAPS` any non-empty folder
 /// will do).
-pub fn maps() -> Result<Vec<PathBuf>, String> {
+pub fn maps() -> Result<Vec<PathBuf>, TestSetError> {
     let d = dir();
     let maps = maps_in(&d)?;
     let wanted = if std::env::var_os(ENV_VAR).is_some_and(|v| !v.is_empty()) { 1 } else { COUNT };
     if maps.len() < wanted {
-        return Err(format!("{}: {} maps, expected at least {wanted}", d.display(), maps.len()));
+        return Err(TestSetError::TooFew { path: d, found: maps.len(), wanted });
     }
     Ok(maps)
 }

@@ -53,6 +53,11 @@ fn named_directions_sit_where_the_convention_says() {
     assert_eq!(map.texel_of_dir(Vec3::new(-1.0, 1e-4, 1e-4)), (767, 255));
     assert_eq!(map.texel_of_dir(Vec3::Y).1, 0);
     assert_eq!(map.texel_of_dir(Vec3::NEG_Y).1, 511);
+    // Right-handed with +Y up: facing -Z, the right-hand side is forward x up = +X, and the
+    // panorama is not mirrored: going right from the seam (u grows) turns towards +X.
+    let right = Vec3::NEG_Z.cross(Vec3::Y);
+    assert!(latlong_uv_to_dir(Vec2::new(0.01, 0.5)).dot(right) > 0.0);
+    assert!(latlong_uv_to_dir(Vec2::new(0.25, 0.5)).dot(right) > 0.999);
 }
 
 #[test]
@@ -142,4 +147,121 @@ fn rotating_by_columns_rotates_directions_about_y() {
     // phi grows: the direction of old texel (i, j) is now found at column i + 8.
     assert_eq!(rotated.pixel(10, 3), map.pixel(2, 3));
     assert_eq!(rotated.pixel(2, 3), map.pixel(26, 3));
+}
+
+#[test]
+fn luminance_uses_the_rec709_weights() {
+    // Y of the Rec.709 primaries (ITU-R BT.709, the Y row of its RGB-to-XYZ matrix)
+    let weights = [0.2126, 0.7152, 0.0722];
+    for (k, w) in weights.iter().enumerate() {
+        let mut rgb = [0.0f32; 3];
+        rgb[k] = 1.0;
+        assert!((envmap_sphere::luminance(Vec3::from_array(rgb)) - w).abs() < 1e-6, "channel {k}");
+    }
+    // white has Y = 1, and Y is linear
+    assert!((envmap_sphere::luminance(Vec3::ONE) - 1.0).abs() < 1e-6);
+    let (a, b) = (Vec3::new(0.3, 2.0, 7.0), Vec3::new(5.0, 0.1, 0.4));
+    let lin = envmap_sphere::luminance(2.0 * a + b) - (2.0 * envmap_sphere::luminance(a) + envmap_sphere::luminance(b));
+    assert!(lin.abs() < 1e-5);
+}
+
+/// The nine functions in the documented order, each its documented polynomial with the
+/// normalization derived here ((2l + 1) / 4 pi (l - m)! / (l + m)!, real form), and together
+/// orthonormal over the sphere (by quadrature, not from the code's constants).
+#[test]
+fn sh_basis_is_the_documented_order_and_orthonormal() {
+    let pi = PI;
+    let c0 = (1.0 / (4.0 * pi)).sqrt();
+    let c1 = (3.0 / (4.0 * pi)).sqrt();
+    let c2 = (15.0 / (4.0 * pi)).sqrt();
+    let c20 = (5.0 / (16.0 * pi)).sqrt();
+    let c22 = (15.0 / (16.0 * pi)).sqrt();
+    let documented = |d: Vec3| {
+        let (x, y, z) = (f64::from(d.x), f64::from(d.y), f64::from(d.z));
+        [
+            c0,
+            c1 * y,
+            c1 * z,
+            c1 * x,
+            c2 * x * y,
+            c2 * y * z,
+            c20 * (3.0 * z * z - 1.0),
+            c2 * x * z,
+            c22 * (x * x - y * y),
+        ]
+    };
+    let mut rng = common::rng(5);
+    for _ in 0..200 {
+        let d = common::random_dir(&mut rng);
+        let got = envmap_sphere::sh::sh9_basis(d);
+        for (k, (g, want)) in got.iter().zip(documented(d)).enumerate() {
+            assert!((f64::from(*g) - want).abs() < 1e-5, "Y_{k} at {d}: {g} vs {want}");
+        }
+    }
+    // orthonormality: midpoint quadrature in (cos theta, phi)
+    let n = 200;
+    let mut gram = [[0.0f64; 9]; 9];
+    for a in 0..n {
+        for b in 0..2 * n {
+            let z = -1.0 + 2.0 * (a as f64 + 0.5) / n as f64;
+            let phi = (b as f64 + 0.5) / (2 * n) as f64 * 2.0 * pi;
+            let r = (1.0 - z * z).sqrt();
+            let y = envmap_sphere::sh::sh9_basis(Vec3::new((r * phi.cos()) as f32, (r * phi.sin()) as f32, z as f32));
+            let w = 4.0 * pi / (2 * n * n) as f64;
+            for i in 0..9 {
+                for j in 0..9 {
+                    gram[i][j] += f64::from(y[i]) * f64::from(y[j]) * w;
+                }
+            }
+        }
+    }
+    for (i, row) in gram.iter().enumerate() {
+        for (j, g) in row.iter().enumerate() {
+            let want = if i == j { 1.0 } else { 0.0 };
+            assert!((g - want).abs() < 1e-3, "<Y_{i}, Y_{j}> = {g}");
+        }
+    }
+}
+
+/// docs/conventions.md says each of its rules is checked by a test named in brackets: every
+/// list item and paragraph under a heading names at least one, and each named test exists here.
+#[test]
+fn conventions_doc_names_an_existing_test_for_every_rule() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let doc = std::fs::read_to_string(root.join("../../docs/conventions.md")).expect("docs/conventions.md");
+    let mut tests = String::new();
+    for entry in std::fs::read_dir(root.join("tests")).expect("tests/") {
+        let path = entry.expect("entry").path();
+        if path.extension().is_some_and(|x| x == "rs") {
+            tests.push_str(&std::fs::read_to_string(&path).expect("read test"));
+        }
+    }
+    // rules: list items and paragraphs after the first heading
+    let mut rules: Vec<String> = Vec::new();
+    let mut open = false;
+    for line in doc.lines().skip_while(|l| !l.starts_with("## ")) {
+        if line.trim().is_empty() || line.starts_with('#') {
+            open = false;
+        } else if line.starts_with("- ") || !open {
+            rules.push(line.to_string());
+            open = true;
+        } else if let Some(last) = rules.last_mut() {
+            last.push(' ');
+            last.push_str(line.trim());
+        }
+    }
+    assert!(rules.len() >= 20, "{} rules found", rules.len());
+    for rule in &rules {
+        let names: Vec<&str> = rule
+            .split('[')
+            .skip(1)
+            .filter_map(|b| b.split(']').next())
+            .filter(|b| b.starts_with('`'))
+            .flat_map(|b| b.split(',').map(|n| n.trim().trim_matches('`')))
+            .collect();
+        assert!(!names.is_empty(), "a rule names no test: {rule}");
+        for n in names {
+            assert!(tests.contains(&format!("fn {n}(")), "{n} is not a test in crates/envmap-sphere/tests/ ({rule})");
+        }
+    }
 }

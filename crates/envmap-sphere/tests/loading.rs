@@ -380,3 +380,29 @@ fn text_from_the_file_cannot_break_an_error_across_lines() {
     assert_eq!(envmap_sphere::error::one_line("a\tb\r\nc"), "a\\tb\\r\\nc");
     assert_eq!(envmap_sphere::error::one_line("plain"), "plain");
 }
+
+/// A 4 x 2 Radiance file (flat scanlines: too narrow for run-length encoding), every pixel the
+/// RGBE bytes `rgbe`, with `extra` header lines.
+fn rgbe_file(extra: &str, rgbe: [u8; 4]) -> Vec<u8> {
+    let mut bytes = format!("#?RADIANCE\n{extra}FORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 4\n").into_bytes();
+    for _ in 0..8 {
+        bytes.extend_from_slice(&rgbe);
+    }
+    bytes
+}
+
+#[test]
+fn radiance_primaries_line_is_ignored() {
+    // (1, 0.5, 0.25): mantissas 128, 64, 32 at exponent 2^1 (byte 129)
+    let rgbe = [128, 64, 32, 129];
+    let plain = EnvMap::load_from_bytes(&rgbe_file("", rgbe), "plain.hdr", &LoadOptions::default())
+        .unwrap_or_else(|e| panic!("{e}"));
+    // wide-gamut primaries that a conversion would visibly change (Rec.2020's)
+    let primaries = "PRIMARIES=0.708 0.292 0.170 0.797 0.131 0.046 0.3127 0.3290\n";
+    let declared = EnvMap::load_from_bytes(&rgbe_file(primaries, rgbe), "declared.hdr", &LoadOptions::default())
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert!(declared.1.converted_from.is_none(), "{:?}", declared.1.converted_from);
+    assert_eq!(plain.0.pixels(), declared.0.pixels(), "the values as stored");
+    let p = plain.0.pixel(1, 1);
+    assert!((p - Vec3::new(1.0, 0.5, 0.25)).abs().max_element() < 0.01, "{p}");
+}

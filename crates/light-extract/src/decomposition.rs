@@ -37,6 +37,30 @@ pub enum ExtractError {
     Parameter(String),
 }
 
+/// Why a decomposition's files could not be written; the message names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum WriteError {
+    /// Creating the folder or writing a file failed.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The folder or file.
+        path: std::path::PathBuf,
+        /// The reason.
+        source: std::io::Error,
+    },
+    /// A JSON document could not be serialized.
+    #[error("{}: {source}", path.display())]
+    Json {
+        /// The file.
+        path: std::path::PathBuf,
+        /// The reason.
+        source: serde_json::Error,
+    },
+    /// An image (EXR or PNG) could not be written; the error names its file.
+    #[error(transparent)]
+    Image(#[from] envmap_sphere::EnvMapError),
+}
+
 /// An environment map decomposed into lights and an ambient remainder.
 #[derive(Clone, Debug)]
 pub struct Decomposition {

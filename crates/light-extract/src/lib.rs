@@ -51,7 +51,8 @@ mod weber;
 pub use above_horizon::{AboveHorizon, narrow_to_horizon, upper_hemisphere};
 pub use center_surround::CenterSurround;
 pub use decomposition::{
-    Decomposition, ExtractError, ExtractedLight, INTERLEAVED_JITTER, INTERLEAVED_SETS, LightExtractor, interleaved_sets,
+    Decomposition, ExtractError, ExtractedLight, INTERLEAVED_JITTER, INTERLEAVED_SETS, LightExtractor, WriteError,
+    interleaved_sets,
 };
 pub use emissive_split::EmissiveSplit;
 pub use importance::ImportanceSampled;

@@ -25,7 +25,7 @@
 //! in W/(m^2 sr); 1 keeps the map's own units), and `color` is `power` divided by its largest
 //! component.
 
-use crate::decomposition::{Decomposition, ExtractedLight};
+use crate::decomposition::{Decomposition, ExtractedLight, WriteError};
 use envmap_sphere::error::one_line;
 use glam::{Quat, Vec3};
 use scene::DistantLight;
@@ -211,16 +211,17 @@ impl Decomposition {
     /// Writes `lights.json`, `ambient.exr` and `lights.gltf` into `dir` (created if missing).
     ///
     /// # Errors
-    /// A message naming the file that could not be written.
-    pub fn write(&self, dir: &Path, interleaved: &[Vec<ExtractedLight>], lux_per_unit: f32) -> Result<(), String> {
-        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-        let write_json = |name: &str, v: &Value| -> Result<(), String> {
+    /// [`WriteError`], naming the folder or file that could not be written.
+    pub fn write(&self, dir: &Path, interleaved: &[Vec<ExtractedLight>], lux_per_unit: f32) -> Result<(), WriteError> {
+        std::fs::create_dir_all(dir).map_err(|source| WriteError::Io { path: dir.to_path_buf(), source })?;
+        let write_json = |name: &str, v: &Value| -> Result<(), WriteError> {
             let path = dir.join(name);
-            let text = serde_json::to_string_pretty(v).map_err(|e| format!("{}: {e}", path.display()))?;
-            std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))
+            let text =
+                serde_json::to_string_pretty(v).map_err(|source| WriteError::Json { path: path.clone(), source })?;
+            std::fs::write(&path, text).map_err(|source| WriteError::Io { path, source })
         };
         write_json("lights.json", &self.to_json(interleaved))?;
         write_json("lights.gltf", &self.to_gltf(lux_per_unit))?;
-        self.ambient.save_exr(dir.join("ambient.exr")).map_err(|e| e.to_string())
+        Ok(self.ambient.save_exr(dir.join("ambient.exr"))?)
     }
 }

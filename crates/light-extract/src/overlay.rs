@@ -35,7 +35,7 @@ pub fn overlay(map: &EnvMap, lights: &[ExtractedLight]) -> Vec<u8> {
 /// Writes [`overlay`] as a PNG.
 ///
 /// # Errors
-/// A message naming the file.
-pub fn write_overlay(path: &Path, map: &EnvMap, lights: &[ExtractedLight]) -> Result<(), String> {
-    envmap_sphere::io::save_png_srgb8(path, map.width(), map.height(), &overlay(map, lights)).map_err(|e| e.to_string())
+/// [`EnvMapError`](envmap_sphere::EnvMapError), naming the file.
+pub fn write_overlay(path: &Path, map: &EnvMap, lights: &[ExtractedLight]) -> Result<(), envmap_sphere::EnvMapError> {
+    envmap_sphere::io::save_png_srgb8(path, map.width(), map.height(), &overlay(map, lights))
 }

@@ -76,6 +76,19 @@ mod tests {
         let light = Vec3::ZERO;
         let tris = [[Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 0.0, -1.0), Vec3::new(0.0, 0.0, 1.0)]];
         let out = subdivide_for_light(&tris, light, 0.01);
-        assert!(out.len() <= 1 << MAX_SPLITS, "{}", out.len());
+        assert!(out.len() > 1 && out.len() <= 1 << MAX_SPLITS, "{}", out.len());
+        // Each bisection halves the area, so a piece made d levels deep has area A / 2^d: the
+        // pieces still wider than the limit (those at the light) are exactly MAX_SPLITS deep,
+        // and together the pieces cover the triangle.
+        let area = |t: &[Vec3; 3]| f64::from(0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length());
+        let whole = area(&tris[0]);
+        let deepest = whole / f64::from(1u32 << MAX_SPLITS);
+        let wide: Vec<_> = out.iter().filter(|t| max_edge_angle(&[**t], light) > 0.01).collect();
+        assert!(!wide.is_empty(), "the pieces at the light cannot meet the limit");
+        for t in &wide {
+            assert!((area(t) / deepest - 1.0).abs() < 1e-3, "a wide piece stopped early: area {}", area(t));
+        }
+        let total: f64 = out.iter().map(area).sum();
+        assert!((total / whole - 1.0).abs() < 1e-4, "{total} vs {whole}");
     }
 }

@@ -46,7 +46,12 @@ impl Setup {
     fn map(&self, triangles: &[[Vec3; 3]], light: &ShadowLight, t: Technique, s: &ShadowSettings) -> ShadowMap {
         let triangles = shadow_triangles(triangles, light, t, s);
         let geometry = ShadowGeometry::upload(&self.gpu, &triangles, ShadowGeometry::CHUNK_TRIANGLES).unwrap();
-        self.mapper.render(&self.gpu, &geometry, light, t, s).unwrap()
+        let map = self.mapper.render(&self.gpu, &geometry, light, t, s).unwrap();
+        // The map reports the rejection it ran: clip distances exactly where the device has them
+        // (so a test asking for them says which path it checked), a discard otherwise.
+        let ran = if self.gpu.has_clip_distances() { s.rejection } else { Rejection::Discard };
+        assert_eq!(map.settings.rejection, ran, "{}", self.gpu.describe());
+        map
     }
 
     fn mask(&self, map: &ShadowMap) -> Vec<f32> {
@@ -58,6 +63,26 @@ impl Setup {
 
     fn truth(&self, light: VisibilityLight) -> Vec<Option<bool>> {
         light_visibility(&SceneBvh::new(&self.scene), &self.points, light)
+    }
+}
+
+/// The adapters this suite runs on, lavapipe (CI) and NVIDIA's, have `CLIP_DISTANCES`: there
+/// the clip-distance tests must run the clip-distance path, not fall back to the discard.
+#[test]
+fn the_clip_distance_path_runs_where_the_adapter_has_it() {
+    let gpu = gpu();
+    let name = gpu.describe().to_lowercase();
+    if name.contains("llvmpipe") || name.contains("nvidia") {
+        assert!(gpu.has_clip_distances(), "{name}: CLIP_DISTANCES not enabled");
+    }
+    let s = Setup::new(room(8, 8));
+    let tris = scene_triangles(&s.scene);
+    let light = ShadowLight::omni(s.scene.point_lights[0].position);
+    for rejection in [Rejection::ClipDistance, Rejection::Discard] {
+        let settings = ShadowSettings { resolution: 64, rejection, ..ShadowSettings::default() };
+        // `Setup::map` asserts the rejection that ran
+        let map = s.map(&tris, &light, Technique::DualParaboloid, &settings);
+        assert!(map.triangles_drawn() > 0);
     }
 }
 

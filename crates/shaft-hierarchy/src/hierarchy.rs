@@ -106,6 +106,9 @@ pub enum BuildError {
     /// A box or transfer is not finite.
     #[error("not finite: {0}")]
     NotFinite(String),
+    /// The built hierarchy fails [`ShaftHierarchy::validate`] (a bug, reported in words).
+    #[error("the hierarchy is broken: {0}")]
+    Broken(String),
 }
 
 /// The shaft hierarchy between a source KD-tree and a receiver octree.

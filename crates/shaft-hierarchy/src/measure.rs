@@ -11,7 +11,7 @@ use real_scene::{RealScene, Visibility, luminance};
 use scene::DistantLight;
 
 use crate::preprocess::{Prepared, Source};
-use crate::{Aabb, Occlusion, ShaftHierarchy, Traversal};
+use crate::{Aabb, BuildError, Occlusion, ShaftHierarchy, Traversal};
 
 /// A box a tenth of the scene's width flying a loop through it, `frames` positions: around
 /// the scene's centre at 35 % of its width and depth, bobbing between 5 % and 55 % of its
@@ -276,18 +276,18 @@ pub struct Figures {
 /// representative set of `representatives`.
 ///
 /// # Errors
-/// A build error, or the hierarchy's `validate` failing (in words).
+/// A build error, or [`BuildError::Broken`] when the hierarchy fails its `validate`.
 pub fn figures(
     scene: &RealScene,
     lights: &[DistantLight],
     vis: &impl Visibility,
     settings: &crate::preprocess::PreprocessSettings,
     (frames, per_frame, representatives): (usize, usize, usize),
-) -> Result<(Figures, Prepared, ShaftHierarchy), String> {
+) -> Result<(Figures, Prepared, ShaftHierarchy), BuildError> {
     let t = Instant::now();
-    let (prepared, h) = crate::preprocess::build(scene, lights, vis, settings).map_err(|e| e.to_string())?;
+    let (prepared, h) = crate::preprocess::build(scene, lights, vis, settings)?;
     let preprocess_s = t.elapsed().as_secs_f64();
-    h.validate().map_err(|e| format!("the hierarchy is broken: {e}"))?;
+    h.validate().map_err(BuildError::Broken)?;
     let objects = object_path(scene, frames);
     let check = check(&h, &prepared, scene, lights, &objects, per_frame, 1);
     let times: Vec<f64> = (0..3).flat_map(|_| frame_times(&h, &objects, representatives)).collect();
