@@ -443,7 +443,7 @@ impl Thresholds {
                 Some(t) => {
                     checked += 1;
                     // a NaN measurement fails too
-                    if !(v <= t) {
+                    if v.is_nan() || v > t {
                         failures.push(format!("{k} = {v:.5} exceeds {t}"));
                     }
                 }
