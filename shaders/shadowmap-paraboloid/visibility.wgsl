@@ -36,8 +36,11 @@ fn cube_face(d: vec3<f32>) -> u32 {
 }
 
 // Fraction of the (2r + 1)^2 texels around `uv` (in [-1, 1], +v up) of layer `layer` whose
-// depth is not less than `depth`.
-fn lit_fraction(uv: vec2<f32>, depth: f32, layer: u32) -> f32 {
+// depth is not less than `depth`. A receiver beyond the map's far plane lies behind whatever
+// the map holds there (a map of a few casters over distant receivers), so its depth is taken
+// as the far plane's.
+fn lit_fraction(uv: vec2<f32>, depth_in: f32, layer: u32) -> f32 {
+    let depth = min(depth_in, 1.0);
     let res = i32(params.views[layer].params.w);
     let x = i32(floor((uv.x * 0.5 + 0.5) * f32(res)));
     let y = i32(floor((0.5 - uv.y * 0.5) * f32(res)));
@@ -160,7 +163,9 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
         }
         let clip = params.views[layer].matrix * vec4<f32>(p, 1.0);
         let ndc = clip.xyz / clip.w;
-        if technique == 2u && (any(abs(ndc.xy) > vec2<f32>(1.0)) || ndc.z < 0.0 || ndc.z > 1.0) {
+        // outside the footprint, or between the light and the map's near plane: nothing can
+        // shadow it; beyond the far plane it is compared at the far plane (`lit_fraction`)
+        if technique == 2u && (any(abs(ndc.xy) > vec2<f32>(1.0)) || ndc.z < 0.0) {
             return vec4<f32>(1.0);
         }
         if technique == 2u && params.pcss.x > 0.5 {
@@ -170,7 +175,7 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
             // a per-pixel turn of the sample pattern (interleaved gradient noise): noise instead
             // of banding, fixed per pixel
             let spin = 6.2831853 * fract(52.9829189 * fract(dot(frag.xy, vec2<f32>(0.06711056, 0.00583715))));
-            return vec4<f32>(pcss(ndc.xy, ndc.z, slope, spin));
+            return vec4<f32>(pcss(ndc.xy, min(ndc.z, 1.0), slope, spin));
         }
         lit = lit_fraction(ndc.xy, ndc.z, layer);
     }

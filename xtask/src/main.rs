@@ -11,6 +11,7 @@ macro_rules! outln {
     }};
 }
 
+mod composite;
 mod eval_lights;
 mod extract;
 mod fuzz;
@@ -187,6 +188,12 @@ enum Command {
         #[arg(long)]
         sweep: bool,
     },
+    /// A synthetic object composited into a built-in real scene's photograph on the GPU
+    /// (paper 003): shadow maps per representative source, transfers subtracted in HDR or, with
+    /// --ldr, intensity transfers in 8-bit codes. Writes OUT (and OUT_photo, _truth, _debevec,
+    /// _error beside it) and prints the error in codes against the path-traced truth and
+    /// Debevec's offline differential rendering, and the time per frame.
+    Composite(composite::CompositeArgs),
     /// Print an environment map's size, format, luminance, power and SH9 coefficients.
     Info {
         /// The map (.exr or .hdr).
@@ -226,6 +233,7 @@ fn main() -> ExitCode {
             };
             shafts::run(&shafts::ShaftsArgs { scene: &scene, json, settings, sweep, photo, out: &out })
         }
+        Command::Composite(args) => composite::run(&args),
         Command::SoftShadows { scenes, size, adapter, out } => {
             soft_shadows::run(&scenes, size, adapter.as_deref(), &out)
         }

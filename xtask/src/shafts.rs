@@ -29,6 +29,20 @@ pub struct ShaftsArgs<'a> {
     pub out: &'a Path,
 }
 
+/// An environment-lit scene's map (the embedded one) and its extracted lights as distant
+/// sources; nothing for a scene lit by its own patches.
+pub fn environment(scene: &RealScene) -> Result<(Option<envmap_sphere::EnvMap>, Vec<scene::DistantLight>), String> {
+    if !scene.environment_lit {
+        return Ok((None, Vec::new()));
+    }
+    let map = envmap_sphere::default_map();
+    let d = light_extract::extractor(crate::validate::DEFAULT_METHOD, 32)
+        .ok_or("no default extractor")?
+        .extract(&map)
+        .map_err(|e| e.to_string())?;
+    Ok((Some(map), d.distant_lights()))
+}
+
 pub fn run(args: &ShaftsArgs) -> Result<(), String> {
     let say = |s: &str| {
         if !args.json {
@@ -38,18 +52,7 @@ pub fn run(args: &ShaftsArgs) -> Result<(), String> {
     let mut scene = RealScene::builtin(args.scene).map_err(|e| e.to_string())?;
     let t = Instant::now();
     let bvh = PatchBvh::new(&scene);
-    // an environment-lit scene gets the embedded map, and its extracted lights as sources
-    let (map, lights) = if scene.environment_lit {
-        let map = envmap_sphere::default_map();
-        let d = light_extract::extractor(crate::validate::DEFAULT_METHOD, 32)
-            .ok_or("no default extractor")?
-            .extract(&map)
-            .map_err(|e| e.to_string())?;
-        let lights = d.distant_lights();
-        (Some(map), lights)
-    } else {
-        (None, Vec::new())
-    };
+    let (map, lights) = environment(&scene)?;
     let report =
         real_scene::solve(&mut scene, &bvh, map.as_ref(), &SolveSettings::default()).map_err(|e| e.to_string())?;
     say(&format!(

@@ -444,3 +444,32 @@ fn shafts_json_has_the_interface_keys_and_misses_nothing() {
     assert_eq!(bad.status.code(), Some(1));
     assert_eq!(String::from_utf8_lossy(&bad.stderr).trim().lines().count(), 1);
 }
+
+#[test]
+fn composite_json_has_the_interface_keys_and_writes_the_images() {
+    let dir = fresh_dir("cli-composite");
+    let out = dir.join("c.png");
+    let args = ["composite", "--scene", "ar_ground", "--object", "sphere", "--at", "0,0.3,1", "--passes", "10"];
+    let size = ["--size", "64x48", "--spp", "8"];
+    let run = xtask(&[&args[..], &size, &["--out", out.to_str().unwrap_or_default(), "--json"]].concat());
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let text = String::from_utf8_lossy(&run.stdout);
+    assert_eq!(text.trim().lines().count(), 1, "one JSON object on one line: {text}");
+    let v: serde_json::Value = serde_json::from_str(&text).expect("valid JSON");
+    for k in ["passes", "ms_per_frame", "error_mae_codes", "debevec_error_mae_codes", "error_rmse_codes"] {
+        assert!(v.get(k).is_some_and(serde_json::Value::is_number), "missing number {k} in {v}");
+    }
+    assert!(v["adapter"].as_str().is_some_and(|a| !a.is_empty()), "{v}");
+    assert_eq!(v["passes"].as_u64(), Some(10));
+    assert!(v["ms_per_frame"].as_f64().unwrap_or(0.0) > 0.0);
+    for f in ["c.png", "c_photo.png", "c_truth.png", "c_debevec.png", "c_error.png"] {
+        assert!(dir.join(f).is_file(), "{f} missing");
+    }
+    // bad input: one line naming what is wrong, exit 1
+    for (bad, want) in [(["--object", "teapot"], "teapot"), (["--at", "1,2"], "--at")] {
+        let run = xtask(&[&["composite", "--scene", "ar_ground", "--size", "16x12", "--spp", "1"][..], &bad].concat());
+        assert_eq!(run.status.code(), Some(1), "{bad:?}");
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert!(err.trim().lines().count() == 1 && err.contains(want), "{err}");
+    }
+}

@@ -35,7 +35,7 @@ pub use gbuffer::{
 };
 pub use geometry::{Chunk, SceneGeometry, ShadowGeometry, scene_triangles};
 pub use interleave::{InterleavePass, interleave_set, interleave_tile};
-pub use readback::{read_texture_f32, read_texture_rgba};
+pub use readback::{read_buffer, read_texture_f32, read_texture_rgba};
 pub use shade::{Background, HDR_FORMAT, ShadeLight, ShadeParams, ShadingPass, Visibility, read_hdr};
 pub use split::{SplitFrame, SplitImage, SplitPasses, SplitSettings, render_split};
 pub use supersample::RotatedGrid;

@@ -17,6 +17,23 @@ pub(crate) fn map_read(gpu: &Gpu, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuE
     Ok(bytes)
 }
 
+/// Copies `buffer` (which needs `COPY_SRC`) back to the CPU.
+///
+/// # Errors
+/// [`GpuError::Failed`] when the copy or the mapping fails.
+pub fn read_buffer(gpu: &Gpu, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
+    let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size: buffer.size(),
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut encoder = gpu.encoder("readback");
+    encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
+    gpu.submit_and_wait(encoder)?;
+    map_read(gpu, &staging)
+}
+
 /// Copies one layer of a texture with 4-byte texels per channel group into tightly packed
 /// bytes, row by row.
 fn read_layer_bytes(

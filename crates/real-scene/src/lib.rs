@@ -14,8 +14,8 @@ mod photo;
 mod radiosity;
 
 pub use builtin::{BUILTIN_REAL_SCENES, Perturbation};
-pub use photo::{CameraResponse, PhotoSettings, photograph};
-pub use radiosity::{SolveReport, SolveSettings, solve};
+pub use photo::{CameraResponse, PhotoSettings, photograph, photograph_with};
+pub use radiosity::{SolveReport, SolveSettings, estimate_reflectances, solve};
 
 use glam::Vec3;
 
@@ -99,6 +99,14 @@ impl RealScene {
             })
             .collect();
         scene::Scene { name: self.name.clone(), objects, camera: self.camera, point_lights: Vec::new() }
+    }
+
+    /// The point synthetic objects are placed from: the centre of the floor (the bounds' centre
+    /// in x and z, their lowest y). `ar_ground`'s is the origin; `ar_room`'s is (2.5, 0, 2).
+    #[must_use]
+    pub fn floor_centre(&self) -> Vec3 {
+        let (lo, hi) = self.bounds();
+        Vec3::new(0.5 * (lo.x + hi.x), lo.y, 0.5 * (lo.z + hi.z))
     }
 
     /// The patches' joint bounds (min, max).

@@ -92,13 +92,29 @@ pub fn photograph(
     map: Option<&EnvMap>,
     settings: &PhotoSettings,
 ) -> Result<ref_tracer::Render, RealSceneError> {
+    photograph_with(scene, &[], map, settings)
+}
+
+/// [`photograph`] of the scene with `extra` objects in it (which do not emit): what a camera
+/// would see with a real object there. Their `object_id`s follow the patches'.
+///
+/// # Errors
+/// As [`photograph`].
+pub fn photograph_with(
+    scene: &RealScene,
+    extra: &[scene::Object],
+    map: Option<&EnvMap>,
+    settings: &PhotoSettings,
+) -> Result<ref_tracer::Render, RealSceneError> {
     if scene.environment_lit != map.is_some() {
         return Err(RealSceneError::NeedsEnvironment(scene.name.clone()));
     }
-    let s = scene.to_scene();
+    let mut s = scene.to_scene();
+    s.objects.extend_from_slice(extra);
     let bvh = ref_tracer::SceneBvh::new(&s);
     let env = map.map(ref_tracer::EnvLight::new);
-    let emission: Vec<Vec3> = scene.patches.iter().map(|p| p.emission).collect();
+    let emission: Vec<Vec3> =
+        scene.patches.iter().map(|p| p.emission).chain(extra.iter().map(|_| Vec3::ZERO)).collect();
     let rs =
         ref_tracer::RenderSettings { spp: settings.spp, seed: settings.seed, ..ref_tracer::RenderSettings::default() };
     let emitters = ref_tracer::Emitters::new(&s, &emission);

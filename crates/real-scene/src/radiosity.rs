@@ -58,6 +58,76 @@ pub fn solve(
     if scene.environment_lit && environment.is_none() {
         return Err(RealSceneError::NeedsEnvironment(scene.name.clone()));
     }
+    let (links, env) = gather_terms(scene, vis, environment, settings);
+    let patches = &scene.patches;
+    let base: Vec<Vec3> = patches.iter().zip(&env).map(|(p, e)| p.emission + p.reflectance * *e).collect();
+    let mut radiance = base.clone();
+    let (mut iterations, mut change) = (0, f32::INFINITY);
+    while iterations < settings.max_iterations && change > settings.tolerance {
+        let next: Vec<Vec3> = links
+            .par_iter()
+            .enumerate()
+            .map(|(k, l)| {
+                let gathered: Vec3 = l.iter().map(|&(q, f)| radiance[q as usize] * f).sum();
+                base[k] + patches[k].reflectance * gathered
+            })
+            .collect();
+        let peak = next.iter().map(|v| v.max_element()).fold(0.0f32, f32::max).max(f32::MIN_POSITIVE);
+        change = next.iter().zip(&radiance).map(|(a, b)| (*a - *b).abs().max_element()).fold(0.0, f32::max) / peak;
+        radiance = next;
+        iterations += 1;
+    }
+    let links_count = links.iter().map(Vec::len).sum();
+    for (p, l) in scene.patches.iter_mut().zip(radiance) {
+        p.radiance = l;
+    }
+    Ok(SolveReport { iterations, change, links: links_count })
+}
+
+/// Sets each patch's reflectance from its radiance as a capture does: measured radiance over
+/// the irradiance (over pi) that the other patches' radiances and the map deliver to it,
+/// rho = (L - L_e) / (E / pi), per channel, clamped to [0, 0.98] (0 where no light arrives).
+/// With the radiances of a radiosity solution it recovers the reflectances solved with.
+///
+/// # Errors
+/// [`RealSceneError::NeedsEnvironment`] for an environment-lit scene without a map.
+pub fn estimate_reflectances(
+    scene: &mut RealScene,
+    vis: &impl Visibility,
+    environment: Option<&EnvMap>,
+    settings: &SolveSettings,
+) -> Result<(), RealSceneError> {
+    if scene.environment_lit && environment.is_none() {
+        return Err(RealSceneError::NeedsEnvironment(scene.name.clone()));
+    }
+    let (links, env) = gather_terms(scene, vis, environment, settings);
+    let reflectances: Vec<Vec3> = links
+        .iter()
+        .zip(&env)
+        .map(|(l, e)| *e + l.iter().map(|&(q, f)| scene.patches[q as usize].radiance * f).sum::<Vec3>())
+        .zip(&scene.patches)
+        .map(|(arriving, p)| {
+            let out = (p.radiance - p.emission).max(Vec3::ZERO);
+            Vec3::from_array(std::array::from_fn(|c| {
+                if arriving[c] > 0.0 { (out[c] / arriving[c]).clamp(0.0, 0.98) } else { 0.0 }
+            }))
+        })
+        .collect();
+    for (p, r) in scene.patches.iter_mut().zip(reflectances) {
+        p.reflectance = r;
+    }
+    Ok(())
+}
+
+/// Per patch, its links (q, F_pq V_pq) to the patches it sees, and the map's irradiance over
+/// pi through the openings.
+#[allow(clippy::type_complexity)]
+fn gather_terms(
+    scene: &RealScene,
+    vis: &impl Visibility,
+    environment: Option<&EnvMap>,
+    settings: &SolveSettings,
+) -> (Vec<Vec<(u32, f32)>>, Vec<Vec3>) {
     let patches = &scene.patches;
     let eps = vis.epsilon();
     let nv = settings.visibility_samples.max(1);
@@ -134,28 +204,7 @@ pub fn solve(
             .collect(),
         _ => vec![Vec3::ZERO; patches.len()],
     };
-    let base: Vec<Vec3> = patches.iter().zip(&env).map(|(p, e)| p.emission + p.reflectance * *e).collect();
-    let mut radiance = base.clone();
-    let (mut iterations, mut change) = (0, f32::INFINITY);
-    while iterations < settings.max_iterations && change > settings.tolerance {
-        let next: Vec<Vec3> = links
-            .par_iter()
-            .enumerate()
-            .map(|(k, l)| {
-                let gathered: Vec3 = l.iter().map(|&(q, f)| radiance[q as usize] * f).sum();
-                base[k] + patches[k].reflectance * gathered
-            })
-            .collect();
-        let peak = next.iter().map(|v| v.max_element()).fold(0.0f32, f32::max).max(f32::MIN_POSITIVE);
-        change = next.iter().zip(&radiance).map(|(a, b)| (*a - *b).abs().max_element()).fold(0.0, f32::max) / peak;
-        radiance = next;
-        iterations += 1;
-    }
-    let links_count = links.iter().map(Vec::len).sum();
-    for (p, l) in scene.patches.iter_mut().zip(radiance) {
-        p.radiance = l;
-    }
-    Ok(SolveReport { iterations, change, links: links_count })
+    (links, env)
 }
 
 /// A number in [0, 1) from (k, salt): PCG-style integer hashing.

@@ -196,3 +196,30 @@ fn against_photo(s: &RealScene, photo: &ref_tracer::Render, min_pixels: u32) -> 
     errors.sort_by(f32::total_cmp);
     (errors, solved / traced)
 }
+
+/// A capture's reflectances: from a solution's radiances, `estimate_reflectances` recovers the
+/// reflectances it was solved with (the same links and map term), whatever the patches held.
+#[test]
+fn estimated_reflectances_recover_the_solved_ones() {
+    let map = EnvMap::from_fn(64, 32, |d| if d.y > 0.0 { Vec3::new(0.6, 0.8, 1.2) } else { Vec3::splat(0.05) });
+    let mut s = RealScene::builtin("ar_ground").unwrap_or_else(|e| panic!("{e}"));
+    let bvh = PatchBvh::new(&s);
+    let settings = SolveSettings { tolerance: 1e-7, max_iterations: 400, ..SolveSettings::default() };
+    solve(&mut s, &bvh, Some(&map), &settings).unwrap_or_else(|e| panic!("{e}"));
+    let solved: Vec<Vec3> = s.patches.iter().map(|p| p.reflectance).collect();
+    for p in &mut s.patches {
+        p.reflectance *= 0.5; // what the estimate must not depend on
+    }
+    real_scene::estimate_reflectances(&mut s, &bvh, Some(&map), &settings).unwrap_or_else(|e| panic!("{e}"));
+    let mut worst = 0.0f32;
+    for (p, want) in s.patches.iter().zip(&solved) {
+        if p.radiance.min_element() > 1e-4 {
+            worst = worst.max(((p.reflectance - *want) / *want).abs().max_element());
+        }
+    }
+    assert!(worst < 1e-3, "largest relative reflectance error {worst}");
+    assert!(matches!(
+        real_scene::estimate_reflectances(&mut s, &bvh, None, &settings),
+        Err(RealSceneError::NeedsEnvironment(_))
+    ));
+}

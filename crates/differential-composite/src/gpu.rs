@@ -1,0 +1,340 @@
+//! The compositor on the GPU (paper 003, Section 7, on wgpu): per frame the G-buffer of the
+//! reconstruction with the object, then per representative a hard shadow map of the object's
+//! simplified mesh from its origin (one hemispherical paraboloid map for a patch, paper 004;
+//! an orthographic map for a distant light), its mask over the G-buffer, and the mask times
+//! the representative's transfer added into a darkening buffer; last the resolve: the object
+//! shaded by its SH9 irradiance, the rest the photograph less the darkening (HDR: in radiance,
+//! then the camera response; LDR: in codes).
+//!
+//! Shaders: `shaders/differential-composite/`.
+
+use std::time::{Duration, Instant};
+
+use glam::Vec3;
+use gpu::{GBuffer, GBufferPass, Gpu, GpuError, SceneGeometry, ShadowGeometry, Visibility};
+use shadowmap_paraboloid::{ShadowLight, ShadowMapper, ShadowSettings, Technique};
+use shaft_hierarchy::preprocess::{Origin, Source};
+use wgpu::util::DeviceExt;
+
+use crate::compositor::{Compositor, Frame};
+use crate::{Mode, SyntheticObject};
+
+/// Knobs of the GPU compositor.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GpuSettings {
+    /// Side of each shadow map, texels (paper: 256).
+    pub map_resolution: u32,
+    /// The sphere's shadow mesh detail (slices; about detail^2 triangles; paper: 100-500).
+    pub shadow_detail: u32,
+}
+
+impl Default for GpuSettings {
+    /// The paper's: 256^2 maps, a 484-triangle sphere.
+    fn default() -> Self {
+        Self { map_resolution: 256, shadow_detail: 22 }
+    }
+}
+
+/// Where a GPU frame's time went (wall clock on the CPU, each stage waited for).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FrameTimes {
+    /// Traversal, representative set and transfers (CPU).
+    pub cpu: Duration,
+    /// The G-buffer of the reconstruction with the object.
+    pub gbuffer: Duration,
+    /// The representatives' shadow maps.
+    pub shadow_maps: Duration,
+    /// Their masks and the darkening.
+    pub masks: Duration,
+    /// The resolve and the readback of the 8-bit image.
+    pub resolve: Duration,
+}
+
+impl FrameTimes {
+    /// The whole frame.
+    #[must_use]
+    pub fn total(&self) -> Duration {
+        self.cpu + self.gbuffer + self.shadow_maps + self.masks + self.resolve
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct GpuPixel {
+    weights: [f32; 4],
+    slot: u32,
+    pad: [u32; 3],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct AccumulateParams {
+    width: u32,
+    height: u32,
+    slots: u32,
+    rep: u32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct ResolveParams {
+    width: u32,
+    height: u32,
+    mode: u32,
+    object: u32,
+    response: [f32; 4],
+    albedo: [f32; 4],
+    irradiance: [[f32; 4]; 9],
+}
+
+/// The GPU compositor of one [`Compositor`]: its static buffers and pipelines.
+pub struct GpuCompositor {
+    pixels: wgpu::Buffer,
+    photo_hdr: wgpu::Buffer,
+    photo_ldr: wgpu::Buffer,
+    darkening: wgpu::Buffer,
+    out: wgpu::Buffer,
+    accumulate: wgpu::ComputePipeline,
+    resolve: wgpu::ComputePipeline,
+    gbuffer: GBufferPass,
+    mapper: ShadowMapper,
+    mask: Visibility,
+    size: (u32, u32),
+}
+
+impl GpuCompositor {
+    /// Uploads `c`'s photograph and pixel table and builds the pipelines.
+    ///
+    /// # Errors
+    /// Sizes beyond the adapter's limits.
+    pub fn new(gpu: &Gpu, c: &Compositor) -> Result<Self, GpuError> {
+        let (w, h) = c.size;
+        gpu.check_texture(w, h, 1)?;
+        let storage = |label: &str, bytes: &[u8], extra: wgpu::BufferUsages| {
+            gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: bytes,
+                usage: wgpu::BufferUsages::STORAGE | extra,
+            })
+        };
+        let table: Vec<GpuPixel> =
+            c.pixels.iter().map(|p| GpuPixel { weights: p.weights, slot: p.slot, pad: [0; 3] }).collect();
+        let hdr: Vec<[f32; 4]> = c.photo_hdr.iter().map(|v| v.extend(1.0).to_array()).collect();
+        let ldr: Vec<u32> = c.photo_ldr.iter().map(|p| pack(*p)).collect();
+        let n = u64::from(w) * u64::from(h);
+        let module = |label: &str, src: &str| gpu::shader::module(&gpu.device, label, src, &[]);
+        let pipeline = |label: &str, m: &wgpu::ShaderModule| {
+            gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(label),
+                layout: None,
+                module: m,
+                entry_point: Some("main"),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let accumulate = pipeline(
+            "composite accumulate",
+            &module("composite accumulate", include_str!("../../../shaders/differential-composite/accumulate.wgsl")),
+        );
+        let resolve = pipeline(
+            "composite resolve",
+            &module("composite resolve", include_str!("../../../shaders/differential-composite/resolve.wgsl")),
+        );
+        Ok(Self {
+            pixels: storage("composite pixels", bytemuck::cast_slice(&table), wgpu::BufferUsages::empty()),
+            photo_hdr: storage("photo hdr", bytemuck::cast_slice(&hdr), wgpu::BufferUsages::empty()),
+            photo_ldr: storage("photo ldr", bytemuck::cast_slice(&ldr), wgpu::BufferUsages::empty()),
+            darkening: gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("darkening"),
+                size: n * 16,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            out: gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("composite"),
+                size: n * 4,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            }),
+            accumulate,
+            resolve,
+            gbuffer: GBufferPass::new(gpu),
+            mapper: ShadowMapper::new(gpu),
+            mask: Visibility::new(gpu, w, h, 1)?,
+            size: (w, h),
+        })
+    }
+
+    /// Composites `frame` (made by `c.frame`) for `object` in `mode`: the 8-bit image and where
+    /// the time went (`cpu` is `frame`'s own).
+    ///
+    /// # Errors
+    /// GPU failures.
+    pub fn composite(
+        &self,
+        gpu: &Gpu,
+        c: &Compositor,
+        frame: &Frame,
+        object: &SyntheticObject,
+        mode: Mode,
+        settings: &GpuSettings,
+    ) -> Result<(Vec<[u8; 3]>, FrameTimes), GpuError> {
+        let (w, h) = self.size;
+        let mut times = FrameTimes { cpu: frame.traversal + frame.transfers, ..FrameTimes::default() };
+        // the G-buffer of the reconstruction with the object (its index: after the patches)
+        let t = Instant::now();
+        let mut scene = c.model.to_scene();
+        scene.objects.push(object.to_object());
+        let geometry = SceneGeometry::upload(gpu, &scene)?;
+        let gb = self.gbuffer.render(gpu, &geometry, &scene.camera)?;
+        times.gbuffer = t.elapsed();
+        // the representatives' transfers, rep-major
+        let slots = c.prepared.transfers.slots;
+        let mut transfers: Vec<[f32; 4]> = Vec::with_capacity(frame.reps.len().max(1) * slots);
+        for r in &frame.reps {
+            let v = match mode {
+                Mode::Hdr => &r.radiance,
+                Mode::Ldr => &r.intensity,
+            };
+            transfers.extend(v.iter().map(|x| x.extend(0.0).to_array()));
+        }
+        if transfers.is_empty() {
+            transfers.push([0.0; 4]);
+        }
+        let transfer_buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("transfers"),
+            contents: bytemuck::cast_slice(&transfers),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let mut clear = gpu.encoder("clear darkening");
+        clear.clear_buffer(&self.darkening, 0, None);
+        gpu.submit_and_wait(clear)?;
+        let casters: Vec<[Vec3; 3]> = {
+            let m = object.shadow_mesh(settings.shadow_detail);
+            (0..m.indices.len()).map(|t| m.triangle(t)).collect()
+        };
+        let casters = ShadowGeometry::upload(gpu, &casters, ShadowGeometry::CHUNK_TRIANGLES)?;
+        let map_settings = ShadowSettings {
+            resolution: settings.map_resolution,
+            // the object's few hundred triangles subtend a small angle from a source
+            subdivide_angle: None,
+            ..ShadowSettings::default()
+        };
+        // the maps first (each renders and waits), then every mask and its share of the
+        // darkening in one submission (the passes reuse one mask layer, in order)
+        let t = Instant::now();
+        let maps = frame
+            .reps
+            .iter()
+            .map(|r| {
+                let (light, technique) = match (r.origin, c.prepared.sources[r.origin_source as usize]) {
+                    (Origin::Point(p), Source::Patch(j)) => {
+                        let n = c.model.patches[j as usize].normal();
+                        (ShadowLight::Point { position: p, hemisphere: Some(n) }, Technique::DualParaboloid)
+                    }
+                    (Origin::Point(p), Source::Distant(_)) => (ShadowLight::omni(p), Technique::DualParaboloid),
+                    (Origin::Direction(d), _) => (ShadowLight::Distant { direction: d }, Technique::Orthographic),
+                };
+                self.mapper.render(gpu, &casters, &light, technique, &map_settings)
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        times.shadow_maps = t.elapsed();
+        let t = Instant::now();
+        let mask_view = self.mask.layer(0);
+        let mut encoder = gpu.encoder("composite masks");
+        for (k, map) in maps.iter().enumerate() {
+            let params = AccumulateParams { width: w, height: h, slots: slots as u32, rep: k as u32 };
+            let uniform = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("accumulate params"),
+                contents: bytemuck::bytes_of(&params),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("accumulate"),
+                layout: &self.accumulate.get_bind_group_layout(0),
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: self.pixels.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 2, resource: transfer_buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&mask_view) },
+                    wgpu::BindGroupEntry { binding: 4, resource: self.darkening.as_entire_binding() },
+                ],
+            });
+            self.mapper.record_visibility(
+                gpu,
+                &mut encoder,
+                map,
+                &gb,
+                shadowmap_paraboloid::VisibilityTarget::Layer(&mask_view),
+                0.0,
+            );
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor::default());
+            pass.set_pipeline(&self.accumulate);
+            pass.set_bind_group(0, &bind, &[]);
+            pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
+        }
+        gpu.submit_and_wait(encoder)?;
+        times.masks = t.elapsed();
+        let t = Instant::now();
+        let image = self.resolve(gpu, c, &gb, frame, object, mode)?;
+        times.resolve = t.elapsed();
+        Ok((image, times))
+    }
+
+    fn resolve(
+        &self,
+        gpu: &Gpu,
+        c: &Compositor,
+        gb: &GBuffer,
+        frame: &Frame,
+        object: &SyntheticObject,
+        mode: Mode,
+    ) -> Result<Vec<[u8; 3]>, GpuError> {
+        let (w, h) = self.size;
+        let irradiance = frame.object_irradiance.irradiance_coefficients().map(|v| v.extend(0.0).to_array());
+        let params = ResolveParams {
+            width: w,
+            height: h,
+            mode: u32::from(mode == Mode::Ldr),
+            object: c.model.patches.len() as u32,
+            response: [c.response.exposure, 1.0 / c.response.gamma, c.response.white, 0.0],
+            albedo: (object.albedo / std::f32::consts::PI).extend(0.0).to_array(),
+            irradiance,
+        };
+        let uniform = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("resolve params"),
+            contents: bytemuck::bytes_of(&params),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let position = gb.position.create_view(&wgpu::TextureViewDescriptor::default());
+        let normal = gb.normal.create_view(&wgpu::TextureViewDescriptor::default());
+        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("resolve"),
+            layout: &self.resolve.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: self.photo_hdr.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: self.photo_ldr.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: self.darkening.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&position) },
+                wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&normal) },
+                wgpu::BindGroupEntry { binding: 6, resource: self.out.as_entire_binding() },
+            ],
+        });
+        let mut encoder = gpu.encoder("composite resolve");
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor::default());
+            pass.set_pipeline(&self.resolve);
+            pass.set_bind_group(0, &bind, &[]);
+            pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
+        }
+        gpu.submit_and_wait(encoder)?;
+        let bytes = gpu::read_buffer(gpu, &self.out)?;
+        Ok(bytes.chunks_exact(4).map(|p| [p[0], p[1], p[2]]).collect())
+    }
+}
+
+fn pack(p: [u8; 3]) -> u32 {
+    u32::from(p[0]) | (u32::from(p[1]) << 8) | (u32::from(p[2]) << 16) | (255 << 24)
+}

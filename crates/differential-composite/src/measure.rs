@@ -1,0 +1,103 @@
+//! Measuring the compositor: for each setting (passes, HDR or LDR) the GPU composite's error
+//! against the truth in 8-bit codes and its time per frame, beside Debevec's offline error; and
+//! Figure 3's datasets from a frame's vertices.
+
+use std::time::Duration;
+
+use gpu::{Gpu, GpuError};
+
+use crate::compositor::Frame;
+use crate::gpu::{FrameTimes, GpuCompositor, GpuSettings};
+use crate::ldr::Dataset;
+use crate::{CodeError, Mode, Session, SyntheticObject, code_error};
+
+/// One setting's figures.
+#[derive(Clone, Debug)]
+pub struct Row {
+    /// Passes asked for (0: one per occluded source).
+    pub passes: usize,
+    /// Representatives drawn.
+    pub reps: usize,
+    /// Sources the traversal reported.
+    pub occluded_sources: usize,
+    /// HDR or LDR.
+    pub mode: Mode,
+    /// Error against the truth.
+    pub error: CodeError,
+    /// The median frame's times over the repeats.
+    pub times: FrameTimes,
+    /// The composite.
+    pub image: Vec<[u8; 3]>,
+}
+
+/// Composites `object` with each of `passes` in each of `modes`, `repeats` times each (the
+/// median frame by total time is kept), against `truth`.
+///
+/// # Errors
+/// GPU failures.
+#[allow(clippy::too_many_arguments)]
+pub fn rows(
+    gpu: &Gpu,
+    gc: &GpuCompositor,
+    session: &Session,
+    object: &SyntheticObject,
+    truth: &[[u8; 3]],
+    passes: &[usize],
+    modes: &[Mode],
+    settings: &GpuSettings,
+    repeats: usize,
+) -> Result<Vec<Row>, GpuError> {
+    let c = &session.compositor;
+    let mut out = Vec::new();
+    for &n in passes {
+        for &mode in modes {
+            let mut runs: Vec<(Frame, Vec<[u8; 3]>, FrameTimes)> = Vec::new();
+            for _ in 0..repeats.max(1) {
+                let frame = c.frame(object, n);
+                let (image, times) = gc.composite(gpu, c, &frame, object, mode, settings)?;
+                runs.push((frame, image, times));
+            }
+            runs.sort_by_key(|r| r.2.total());
+            let (frame, image, times) = runs.swap_remove(runs.len() / 2);
+            out.push(Row {
+                passes: n,
+                reps: frame.reps.len(),
+                occluded_sources: frame.occluded_sources,
+                mode,
+                error: code_error(&image, truth, &c.photo_ldr),
+                times,
+                image,
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// Milliseconds of a duration.
+#[must_use]
+pub fn ms(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}
+
+/// Figure 3's datasets from `frame`: up to `count` receiver vertices with at least `sources`
+/// non-zero transfers from the frame's occluded sources (one representative a source), those
+/// with the most radiance first, each with its `sources` largest transfers.
+#[must_use]
+pub fn figure3_datasets(session: &Session, frame: &Frame, count: usize, sources: usize) -> Vec<Dataset> {
+    let c = &session.compositor;
+    let mut vertices: Vec<Dataset> = (0..c.prepared.transfers.slots)
+        .filter_map(|s| {
+            let mut t: Vec<glam::Vec3> =
+                frame.reps.iter().map(|r| r.radiance[s]).filter(|v| v.max_element() > 0.0).collect();
+            if t.len() < sources {
+                return None;
+            }
+            t.sort_by(|a, b| real_scene::luminance(*b).total_cmp(&real_scene::luminance(*a)));
+            t.truncate(sources);
+            Some(Dataset { radiance: c.vertex_radiance[s], transfers: t })
+        })
+        .collect();
+    vertices.sort_by(|a, b| real_scene::luminance(b.radiance).total_cmp(&real_scene::luminance(a.radiance)));
+    vertices.truncate(count);
+    vertices
+}

@@ -1,0 +1,269 @@
+//! `cargo xtask composite`: a synthetic object composited into a built-in real scene's
+//! photograph on the GPU (paper 003), against the path-traced truth and Debevec's offline
+//! differential rendering: errors in 8-bit codes, time per frame, the images; `--sweep` for
+//! every passes x HDR/LDR setting and Figure 3, `--path` for a moving object.
+
+use std::path::{Path, PathBuf};
+
+use differential_composite::gpu::{GpuCompositor, GpuSettings};
+use differential_composite::measure::{figure3_datasets, ms, rows};
+use differential_composite::{Mode, Session, SessionSettings, code_error};
+use glam::Vec3;
+use real_scene::{Perturbation, PhotoSettings, RealScene};
+
+use crate::parse_size;
+
+/// The command's options.
+#[derive(clap::Args)]
+pub struct CompositeArgs {
+    /// The built-in real scene (ar_room, ar_ground).
+    #[arg(long, default_value = "ar_room")]
+    pub scene: String,
+    /// The built-in object (sphere, box).
+    #[arg(long, default_value = "sphere")]
+    pub object: String,
+    /// The object's centre X,Y,Z in metres from the floor's centre (y up).
+    #[arg(long, default_value = "0,0.3,0.5", allow_hyphen_values = true)]
+    pub at: String,
+    /// Shadow passes (representative sources); 0: one per occluded source.
+    #[arg(long, default_value_t = 50)]
+    pub passes: usize,
+    /// Subtract intensity transfers from the 8-bit photograph (paper 003's LDR path).
+    #[arg(long)]
+    pub ldr: bool,
+    /// The composite image.
+    #[arg(long, default_value = "target/composite/composite.png")]
+    pub out: PathBuf,
+    /// One JSON object: passes, ms_per_frame, error_mae_codes, debevec_error_mae_codes,
+    /// error_rmse_codes, adapter (and more).
+    #[arg(long)]
+    pub json: bool,
+    /// Move the object across the floor in this many frames (from 1 m left of --at to 1 m
+    /// right): each frame's time and error against its own truth.
+    #[arg(long)]
+    pub path: Option<usize>,
+    /// Every setting: passes 1, 10, 20, 50 and all, HDR and LDR; and Figure 3.
+    #[arg(long)]
+    pub sweep: bool,
+    /// Image size WIDTHxHEIGHT.
+    #[arg(long, value_parser = parse_size, default_value = "320x240")]
+    pub size: (u32, u32),
+    /// Samples per pixel of the photograph, the truth and Debevec's renders.
+    #[arg(long, default_value_t = 32)]
+    pub spp: u32,
+    /// The reconstruction's reflectances times this (1: exact).
+    #[arg(long, default_value_t = 1.0)]
+    pub reflectance_scale: f32,
+    /// Shadow-map side in texels.
+    #[arg(long, default_value_t = 256)]
+    pub map_resolution: u32,
+    /// The sphere's shadow-mesh detail (slices; about detail^2 triangles).
+    #[arg(long, default_value_t = 22)]
+    pub shadow_detail: u32,
+    /// The GPU adapter: a case-insensitive part of its name, or `cpu`.
+    #[arg(long)]
+    pub adapter: Option<String>,
+}
+
+/// "X,Y,Z" in metres.
+pub fn parse_at(s: &str) -> Result<Vec3, String> {
+    let v: Vec<f32> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("--at {s:?}: {e}"))?;
+    match v.as_slice() {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(Vec3::new(*x, *y, *z)),
+        _ => Err(format!("--at {s:?}: three finite numbers X,Y,Z")),
+    }
+}
+
+pub fn run(args: &CompositeArgs) -> Result<(), String> {
+    let say = |s: &str| {
+        if !args.json {
+            outln!("{s}");
+        }
+    };
+    let e = |e: differential_composite::CompositeError| e.to_string();
+    let at = parse_at(&args.at)?;
+    let gpu_settings = GpuSettings { map_resolution: args.map_resolution, shadow_detail: args.shadow_detail };
+    let gpu = crate::lavapipe::open_gpu(args.adapter.as_deref())?;
+    say(&format!("GPU: {}", gpu.describe()));
+    let probe = RealScene::builtin(&args.scene).map_err(|e| e.to_string())?;
+    let (map, lights) = crate::shafts::environment(&probe)?;
+    let settings = SessionSettings {
+        size: Some(args.size),
+        photo: PhotoSettings { spp: args.spp, ..SessionSettings::default().photo },
+        reconstruction: Perturbation { reflectance_scale: args.reflectance_scale, ..Perturbation::NONE },
+        ..SessionSettings::default()
+    };
+    let t = std::time::Instant::now();
+    let session = Session::new(&args.scene, map, lights, &settings).map_err(e)?;
+    let c = &session.compositor;
+    say(&format!(
+        "{}: {} x {}, photograph {} spp, {} sources, {} receivers; reconstruction with reflectances x {} ({:.1} s)",
+        args.scene,
+        args.size.0,
+        args.size.1,
+        args.spp,
+        c.prepared.sources.len(),
+        c.prepared.receivers.len(),
+        args.reflectance_scale,
+        t.elapsed().as_secs_f64()
+    ));
+    let gc = GpuCompositor::new(&gpu, c).map_err(|e| e.to_string())?;
+    let mode = if args.ldr { Mode::Ldr } else { Mode::Hdr };
+    if let Some(frames) = args.path {
+        return moving(args, (&gpu, &gc, &gpu_settings), &session, (at, frames.max(1)), mode);
+    }
+    let object = session.object(&args.object, at).map_err(e)?;
+    let t = std::time::Instant::now();
+    let truth = session.truth(&object).map_err(e)?;
+    let debevec = session.debevec(&object).map_err(e)?;
+    say(&format!("truth and Debevec's differential rendering path traced ({:.1} s)", t.elapsed().as_secs_f64()));
+    let deb = code_error(&debevec, &truth, &c.photo_ldr);
+    let passes: Vec<usize> = if args.sweep { vec![1, 10, 20, 50, 0] } else { vec![args.passes] };
+    let modes: Vec<Mode> = if args.sweep { vec![Mode::Hdr, Mode::Ldr] } else { vec![mode] };
+    let table =
+        rows(&gpu, &gc, &session, &object, &truth, &passes, &modes, &gpu_settings, 5).map_err(|e| e.to_string())?;
+    let (w, h) = args.size;
+    let save = |path: &Path, img: &[[u8; 3]]| {
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        }
+        envmap_sphere::io::save_png_srgb8(path, w, h, &img.iter().flatten().copied().collect::<Vec<u8>>())
+            .map_err(|e| e.to_string())
+    };
+    let beside = |suffix: &str| -> PathBuf {
+        let stem = args.out.file_stem().map_or_else(|| "composite".into(), |s| s.to_string_lossy().to_string());
+        args.out.with_file_name(format!("{stem}_{suffix}.png"))
+    };
+    let main = table.last().ok_or("no composite")?;
+    save(&args.out, &main.image)?;
+    save(&beside("photo"), &c.photo_ldr)?;
+    save(&beside("truth"), &truth)?;
+    save(&beside("debevec"), &debevec)?;
+    save(&beside("error"), &error_image(&main.image, &truth))?;
+    if args.json {
+        let v = serde_json::json!({
+            "scene": args.scene,
+            "object": args.object,
+            "at": at.to_array(),
+            "passes": main.passes,
+            "representatives": main.reps,
+            "occluded_sources": main.occluded_sources,
+            "mode": if main.mode == Mode::Ldr { "ldr" } else { "hdr" },
+            "ms_per_frame": ms(main.times.total()),
+            "ms_cpu": ms(main.times.cpu),
+            "ms_gbuffer": ms(main.times.gbuffer),
+            "ms_shadow_maps": ms(main.times.shadow_maps),
+            "ms_masks": ms(main.times.masks),
+            "ms_resolve": ms(main.times.resolve),
+            "error_mae_codes": main.error.mae_changed,
+            "error_rmse_codes": main.error.rmse_changed,
+            "error_mae_codes_image": main.error.mae,
+            "error_rmse_codes_image": main.error.rmse,
+            "debevec_error_mae_codes": deb.mae_changed,
+            "debevec_error_rmse_codes": deb.rmse_changed,
+            "changed_pixels": main.error.changed,
+            "size": [w, h],
+            "spp": args.spp,
+            "reflectance_scale": args.reflectance_scale,
+            "adapter": gpu.info.name,
+        });
+        outln!("{v}");
+        return Ok(());
+    }
+    outln!(
+        "Debevec (offline, same model): MAE {:.2} codes, RMSE {:.2} over the {} pixels the object changed",
+        deb.mae_changed,
+        deb.rmse_changed,
+        deb.changed
+    );
+    outln!(
+        "passes | reps | mode | MAE codes | RMSE codes | / Debevec | ms per frame (cpu + gbuffer + maps + masks + resolve)"
+    );
+    for r in &table {
+        let t = &r.times;
+        outln!(
+            "{:>6} | {:>4} | {} | {:>9.2} | {:>10.2} | {:>9.2} | {:.2} ({:.2} + {:.2} + {:.2} + {:.2} + {:.2})",
+            if r.passes == 0 { "all".to_string() } else { r.passes.to_string() },
+            r.reps,
+            if r.mode == Mode::Ldr { "LDR" } else { "HDR" },
+            r.error.mae_changed,
+            r.error.rmse_changed,
+            r.error.mae_changed / deb.mae_changed.max(1e-9),
+            ms(t.total()),
+            ms(t.cpu),
+            ms(t.gbuffer),
+            ms(t.shadow_maps),
+            ms(t.masks),
+            ms(t.resolve)
+        );
+    }
+    if args.sweep {
+        let frame = c.frame(&object, 0);
+        let data = figure3_datasets(&session, &frame, 4, 50);
+        outln!(
+            "Figure 3 ({} vertices with 50 occluded sources; RMS error in codes for P occluded, 10000 trials):",
+            data.len()
+        );
+        for share in [0.5, 0.25, 0.1] {
+            let curve = differential_composite::ldr::figure3(&data, &c.response, share, 10_000, 1);
+            let row: Vec<String> = curve.iter().step_by(5).map(|(p, e)| format!("{p}:{e:.2}")).collect();
+            outln!("  split {:.0}/{:.0}: {}", share * 100.0, (1.0 - share) * 100.0, row.join(" "));
+        }
+    }
+    outln!("wrote {} (and _photo, _truth, _debevec, _error)", args.out.display());
+    Ok(())
+}
+
+/// |image - truth| x 8 per channel, the error map.
+fn error_image(image: &[[u8; 3]], truth: &[[u8; 3]]) -> Vec<[u8; 3]> {
+    image
+        .iter()
+        .zip(truth)
+        .map(|(a, t)| std::array::from_fn(|c| (u16::from(a[c].abs_diff(t[c])) * 8).min(255) as u8))
+        .collect()
+}
+
+/// `frames` positions along a line across the floor: per frame the traversal, the GPU
+/// composite, its time and its error against that frame's truth.
+fn moving(
+    args: &CompositeArgs,
+    (gpu, gc, settings): (&gpu::Gpu, &GpuCompositor, &GpuSettings),
+    session: &Session,
+    (start, frames): (Vec3, usize),
+    mode: Mode,
+) -> Result<(), String> {
+    let e = |e: differential_composite::CompositeError| e.to_string();
+    let c = &session.compositor;
+    let mut out = Vec::new();
+    for k in 0..frames {
+        let s = if frames > 1 { k as f32 / (frames - 1) as f32 } else { 0.0 };
+        let at = start + Vec3::new(-1.0 + 2.0 * s, 0.0, 0.0);
+        let object = session.object(&args.object, at).map_err(e)?;
+        let frame = c.frame(&object, args.passes);
+        let (image, times) = gc.composite(gpu, c, &frame, &object, mode, settings).map_err(|e| e.to_string())?;
+        let truth = session.truth(&object).map_err(e)?;
+        let err = code_error(&image, &truth, &c.photo_ldr);
+        if args.json {
+            out.push(serde_json::json!({"frame": k, "at": at.to_array(), "ms_per_frame": ms(times.total()), "error_mae_codes": err.mae_changed, "error_rmse_codes": err.rmse_changed, "representatives": frame.reps.len()}));
+        } else {
+            outln!(
+                "frame {k:>3} at [{:+.2}, {:+.2}, {:+.2}]: {} reps, {:.2} ms, MAE {:.2} codes, RMSE {:.2}",
+                at.x,
+                at.y,
+                at.z,
+                frame.reps.len(),
+                ms(times.total()),
+                err.mae_changed,
+                err.rmse_changed
+            );
+        }
+    }
+    if args.json {
+        outln!("{}", serde_json::json!({"frames": out, "adapter": gpu.info.name}));
+    }
+    Ok(())
+}
