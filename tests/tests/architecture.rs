@@ -126,3 +126,16 @@ fn shafts_ask_a_visibility_trait_and_never_touch_wgpu() {
         "shaft-hierarchy traces rays itself: {direct:?}"
     );
 }
+
+#[test]
+fn the_interactive_compositor_never_path_traces() {
+    // differential-composite: the path tracer makes the capture and the references (`offline`,
+    // `setup`); the compositor itself works from transfers, masks and the photograph
+    let dir = workspace_tests::workspace_root().join("crates/differential-composite/src");
+    for module in ["compositor.rs", "cpu.rs", "gpu.rs", "ldr.rs"] {
+        let text = std::fs::read_to_string(dir.join(module)).unwrap_or_else(|e| panic!("{module}: {e}"));
+        for traced in ["photograph(", "photograph_with(", "Integrator", "ref_tracer::render", "offline::"] {
+            assert!(!text.contains(traced), "{module} path traces ({traced})");
+        }
+    }
+}

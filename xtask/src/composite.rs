@@ -10,6 +10,7 @@ use differential_composite::measure::{figure3_datasets, ms, rows};
 use differential_composite::{Mode, Session, SessionSettings, code_error};
 use glam::Vec3;
 use real_scene::{Perturbation, PhotoSettings, RealScene};
+use shaft_hierarchy::preprocess::PreprocessSettings;
 
 use crate::parse_size;
 
@@ -54,6 +55,14 @@ pub struct CompositeArgs {
     /// The reconstruction's reflectances times this (1: exact).
     #[arg(long, default_value_t = 1.0)]
     pub reflectance_scale: f32,
+    /// Estimate the reconstruction's reflectances from the capture's radiances (radiance over
+    /// computed irradiance) instead of solving it with its own.
+    #[arg(long)]
+    pub estimate_reflectances: bool,
+    /// The shaft hierarchy's pruning: a pair below this fraction of every reached vertex's
+    /// radiance is dropped (paper: 0.02).
+    #[arg(long, default_value_t = 0.02)]
+    pub prune: f32,
     /// Shadow-map side in texels.
     #[arg(long, default_value_t = 256)]
     pub map_resolution: u32,
@@ -95,13 +104,17 @@ pub fn run(args: &CompositeArgs) -> Result<(), String> {
         size: Some(args.size),
         photo: PhotoSettings { spp: args.spp, ..SessionSettings::default().photo },
         reconstruction: Perturbation { reflectance_scale: args.reflectance_scale, ..Perturbation::NONE },
-        ..SessionSettings::default()
+        estimate_reflectances: args.estimate_reflectances,
+        preprocess: PreprocessSettings {
+            hierarchy: shaft_hierarchy::Settings { prune_fraction: args.prune, ..shaft_hierarchy::Settings::PAPER },
+            ..PreprocessSettings::PAPER
+        },
     };
     let t = std::time::Instant::now();
     let session = Session::new(&args.scene, map, lights, &settings).map_err(e)?;
     let c = &session.compositor;
     say(&format!(
-        "{}: {} x {}, photograph {} spp, {} sources, {} receivers; reconstruction with reflectances x {} ({:.1} s)",
+        "{}: {} x {}, photograph {} spp, {} sources, {} receivers; reconstruction with reflectances x {}{}, pruning {} ({:.1} s)",
         args.scene,
         args.size.0,
         args.size.1,
@@ -109,6 +122,8 @@ pub fn run(args: &CompositeArgs) -> Result<(), String> {
         c.prepared.sources.len(),
         c.prepared.receivers.len(),
         args.reflectance_scale,
+        if args.estimate_reflectances { ", then estimated from the capture" } else { "" },
+        args.prune,
         t.elapsed().as_secs_f64()
     ));
     let gc = GpuCompositor::new(&gpu, c).map_err(|e| e.to_string())?;
@@ -169,6 +184,8 @@ pub fn run(args: &CompositeArgs) -> Result<(), String> {
             "size": [w, h],
             "spp": args.spp,
             "reflectance_scale": args.reflectance_scale,
+            "estimate_reflectances": args.estimate_reflectances,
+            "prune": args.prune,
             "adapter": gpu.info.name,
         });
         outln!("{v}");
@@ -203,9 +220,14 @@ pub fn run(args: &CompositeArgs) -> Result<(), String> {
     }
     if args.sweep {
         let frame = c.frame(&object, 0);
-        let data = figure3_datasets(&session, &frame, 4, 50);
+        // the paper's 50 sources a vertex where the scene has them
+        let (data, n) = [50, 32, 16, 8]
+            .iter()
+            .map(|&n| (figure3_datasets(&session, &frame, 4, n), n))
+            .find(|(d, _)| !d.is_empty())
+            .unwrap_or_default();
         outln!(
-            "Figure 3 ({} vertices with 50 occluded sources; RMS error in codes for P occluded, 10000 trials):",
+            "Figure 3 ({} vertices with {n} occluded sources; RMS error in codes for P occluded, 10000 trials):",
             data.len()
         );
         for share in [0.5, 0.25, 0.1] {

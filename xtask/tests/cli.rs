@@ -101,12 +101,12 @@ fn validate_quick_runs_from_a_copied_binary_and_meets_its_thresholds() {
     let dir = dir.join("out");
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{text}\n{}", String::from_utf8_lossy(&out.stderr));
-    assert!(text.contains("[1/9] load environment map") && text.contains("[9/9] report"), "{text}");
+    assert!(text.contains("[1/10] load environment map") && text.contains("[10/10] report"), "{text}");
     // the adapter is named before any work, and again by the GPU stage
     let first = text.lines().next().unwrap_or_default();
     let adapter = first.strip_prefix("GPU: ").unwrap_or_else(|| panic!("first line {first:?}"));
     let name = adapter.split(" (").next().unwrap_or_default();
-    assert!(text.lines().any(|l| l.contains("[5/9] GPU") && l.contains(name)), "{text}");
+    assert!(text.lines().any(|l| l.contains("[5/10] GPU") && l.contains(name)), "{text}");
     assert!(text.contains("thresholds met") && !text.contains(" 0 thresholds met"), "{text}");
     let html = std::fs::read_to_string(dir.join("report.html")).expect("report written");
     assert!(html.contains("data:image/png;base64,") && !html.contains("src=\"http"), "images embedded");
@@ -119,6 +119,8 @@ fn validate_quick_runs_from_a_copied_binary_and_meets_its_thresholds() {
         "paraboloid_1024_clip",
         "cube_592",
         "GPU adapter",
+        "Compositing (paper 003)",
+        "composite_gpu_50_hdr",
     ] {
         assert!(html.contains(row), "report lacks {row}");
     }

@@ -259,14 +259,18 @@ impl Compositor {
     }
 
     /// SH9 of the radiance arriving at `p` from the model (and the map past it): the object's
-    /// lighting, as paper 003's irradiance volume gives it.
+    /// lighting, as paper 003's irradiance volume gives it. Where the scene has a map, each
+    /// extracted light that `p` sees is added as its cone's power along its axis (a sun of a
+    /// few texels is found by no probe ray) and its cone is left out of the probe.
     #[must_use]
     pub fn irradiance_at(&self, p: Vec3) -> Sh9 {
         // 2 x 2 rays a texel: a small bright source (the lamp, a third of a texel at 32 x 16)
         // must not hinge on whether a texel centre finds it
         let (w, h) = (64u32, 32u32);
+        let in_a_light = |d: Vec3| self.lights.iter().any(|l| d.dot(l.direction) >= l.cos_half_angle());
         let radiance = |d: Vec3| match self.bvh.first_hit(p, d) {
             Some((patch, _)) => self.model.patches[patch as usize].radiance,
+            None if in_a_light(d) => Vec3::ZERO,
             None => self.map.as_ref().map_or(Vec3::ZERO, |m| m.lookup(d)),
         };
         let probe = EnvMap::from_texels(w, h, |i, j| {
@@ -279,7 +283,14 @@ impl Compositor {
                 .sum::<Vec3>()
                 / 4.0
         });
-        Sh9::project(&probe)
+        let mut sh = Sh9::project(&probe);
+        for l in self.lights.iter().filter(|l| self.bvh.first_hit(p, l.direction).is_none()) {
+            let power = l.radiance * l.solid_angle;
+            for (c, y) in sh.coeffs.iter_mut().zip(envmap_sphere::sh::sh9_basis(l.direction)) {
+                *c += power * y;
+            }
+        }
+        sh
     }
 }
 

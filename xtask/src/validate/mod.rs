@@ -5,6 +5,7 @@
 //! time them, write `target/validate/report.html` (self-contained) and each image as EXR beside it, and fail when an error
 //! exceeds its threshold in `validate/thresholds.json`.
 
+mod composite_stage;
 mod gpu_stages;
 mod readme;
 mod report;
@@ -190,7 +191,7 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
     let gpu = crate::lavapipe::open_gpu(args.adapter.as_deref())?;
     outln!("GPU: {}", gpu.describe());
     let thresholds = load_thresholds(args.thresholds.as_deref())?;
-    let mut stages = Stages { total: 9, done: 0, start: Instant::now() };
+    let mut stages = Stages { total: 10, done: 0, start: Instant::now() };
     stages.next("load environment map");
     let map = load_map(args.envmap.as_deref())?;
     let map_name = args.envmap.as_ref().map_or_else(
@@ -266,6 +267,9 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
     stages.next("room: point-light shadow maps against ray-traced visibility, and their speed");
     let (mask_rows, mask_images, size_rows, clock) = room_masks(&gpu, &passes, &plan)?;
 
+    stages.next("compositing: a sphere into ar_ground's photograph, against the truth and Debevec's method");
+    let compositing = composite_stage::run(&gpu, args.quick)?;
+
     stages.next("metrics");
     let tm = FlipTonemap::for_reference(&reference.color);
     let metric = |img: &[Vec3]| (rmse(&reference.color, img), flip(&reference.color, img, w, h, &tm));
@@ -328,6 +332,7 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
     for m in &mask_rows {
         measured.insert(format!("{room_key}:{}.disagreement", m.name), m.disagreement);
     }
+    measured.extend(compositing.measured(args.quick));
     let (failures, checked) = thresholds.check(&measured);
     let report = Report {
         gpu: &gpu,
@@ -346,6 +351,7 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
         lights: lights.len(),
         method: &args.method,
         extract_ms: decomposition.time_ms,
+        compositing: &compositing,
     };
     let path = args.out.join("report.html");
     std::fs::write(&path, report.html(&args.out)?).map_err(|e| format!("{}: {e}", path.display()))?;

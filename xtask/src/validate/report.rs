@@ -27,6 +27,7 @@ pub(super) struct Report<'a> {
     pub(super) lights: usize,
     pub(super) extract_ms: f64,
     pub(super) method: &'a str,
+    pub(super) compositing: &'a super::composite_stage::Compositing,
 }
 
 /// Relative luminance error as an 8-bit heat map (black 0, red 25 %, yellow 50 %, white ≥ 75 %).
@@ -190,7 +191,9 @@ impl Report<'_> {
             let img = self.png(dir, name, *size, &bytes)?;
             let _ = write!(s, "<figure>{img}<figcaption>{name}</figcaption></figure>");
         }
-        s.push_str("</div></body></html>\n");
+        s.push_str("</div>");
+        s.push_str(&self.compositing.html(&|name, size, bytes| self.png(dir, name, size, bytes))?);
+        s.push_str("</body></html>\n");
         Ok(s)
     }
 }
