@@ -69,6 +69,9 @@ pub struct CompositeArgs {
     /// The sphere's shadow-mesh detail (slices; about detail^2 triangles).
     #[arg(long, default_value_t = 22)]
     pub shadow_detail: u32,
+    /// A patch source's shadow map: `paraboloid` (one hemispherical map, paper 004) or `cube`.
+    #[arg(long, default_value = "paraboloid")]
+    pub patch_maps: String,
     /// The GPU adapter: a case-insensitive part of its name, or `cpu`.
     #[arg(long)]
     pub adapter: Option<String>,
@@ -95,7 +98,13 @@ pub fn run(args: &CompositeArgs) -> Result<(), String> {
     };
     let e = |e: differential_composite::CompositeError| e.to_string();
     let at = parse_at(&args.at)?;
-    let gpu_settings = GpuSettings { map_resolution: args.map_resolution, shadow_detail: args.shadow_detail };
+    let patch_maps = match args.patch_maps.as_str() {
+        "paraboloid" => shadowmap_paraboloid::Technique::DualParaboloid,
+        "cube" => shadowmap_paraboloid::Technique::Cube,
+        other => return Err(format!("--patch-maps {other:?}: paraboloid or cube")),
+    };
+    let gpu_settings =
+        GpuSettings { map_resolution: args.map_resolution, shadow_detail: args.shadow_detail, patch_maps };
     let gpu = crate::lavapipe::open_gpu(args.adapter.as_deref())?;
     say(&format!("GPU: {}", gpu.describe()));
     let probe = RealScene::builtin(&args.scene).map_err(|e| e.to_string())?;

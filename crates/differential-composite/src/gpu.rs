@@ -26,12 +26,15 @@ pub struct GpuSettings {
     pub map_resolution: u32,
     /// The sphere's shadow mesh detail (slices; about detail^2 triangles; paper: 100-500).
     pub shadow_detail: u32,
+    /// A patch source's map: one hemispherical paraboloid (paper 004), or a cube of six faces
+    /// (the baseline that does not know the source emits into a hemisphere).
+    pub patch_maps: Technique,
 }
 
 impl Default for GpuSettings {
-    /// The paper's: 256^2 maps, a 484-triangle sphere.
+    /// The paper's: 256^2 maps, a 484-triangle sphere, hemispherical paraboloid maps.
     fn default() -> Self {
-        Self { map_resolution: 256, shadow_detail: 22 }
+        Self { map_resolution: 256, shadow_detail: 22, patch_maps: Technique::DualParaboloid }
     }
 }
 
@@ -229,6 +232,9 @@ impl GpuCompositor {
             .iter()
             .map(|r| {
                 let (light, technique) = match (r.origin, c.prepared.sources[r.origin_source as usize]) {
+                    (Origin::Point(p), Source::Patch(_)) if settings.patch_maps == Technique::Cube => {
+                        (ShadowLight::omni(p), Technique::Cube)
+                    }
                     (Origin::Point(p), Source::Patch(j)) => {
                         let n = c.model.patches[j as usize].normal();
                         (ShadowLight::Point { position: p, hemisphere: Some(n) }, Technique::DualParaboloid)
