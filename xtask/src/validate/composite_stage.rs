@@ -15,6 +15,9 @@ use real_scene::{PhotoSettings, RealScene};
 /// Where the sphere sits, from the floor's centre: on the ground in front of the boxes.
 const AT: Vec3 = Vec3::new(0.0, 0.3, 1.0);
 
+/// Writes an image (name, size, 8-bit RGB) and returns its `<img>` element.
+pub(super) type WritePng<'a> = dyn Fn(&str, (u32, u32), &[u8]) -> Result<String, String> + 'a;
+
 /// The stage's results.
 pub(super) struct Compositing {
     pub(super) size: (u32, u32),
@@ -89,10 +92,7 @@ impl Compositing {
     }
 
     /// The report's section; `png` writes an image and returns its `<img>`.
-    pub(super) fn html(
-        &self,
-        png: &dyn Fn(&str, (u32, u32), &[u8]) -> Result<String, String>,
-    ) -> Result<String, String> {
+    pub(super) fn html(&self, png: &WritePng<'_>) -> Result<String, String> {
         let mut s = String::new();
         let _ = write!(
             s,
