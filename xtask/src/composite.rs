@@ -210,21 +210,15 @@ pub fn run(args: &CompositeArgs) -> Result<(), String> {
         "passes | reps | mode | MAE codes | RMSE codes | / Debevec | ms per frame (cpu + gbuffer + maps + masks + resolve)"
     );
     for r in &table {
-        let t = &r.times;
+        let [total, cpu, gbuffer, maps, masks, resolve] = r.times_ms();
         outln!(
-            "{:>6} | {:>4} | {} | {:>9.2} | {:>10.2} | {:>9.2} | {:.2} ({:.2} + {:.2} + {:.2} + {:.2} + {:.2})",
-            if r.passes == 0 { "all".to_string() } else { r.passes.to_string() },
+            "{:>6} | {:>4} | {} | {:>9.2} | {:>10.2} | {:>9.2} | {total:.2} ({cpu:.2} + {gbuffer:.2} + {maps:.2} + {masks:.2} + {resolve:.2})",
+            r.passes_label(),
             r.reps,
-            if r.mode == Mode::Ldr { "LDR" } else { "HDR" },
+            r.mode_label(),
             r.error.mae_changed,
             r.error.rmse_changed,
             r.error.mae_changed / deb.mae_changed.max(1e-9),
-            ms(t.total()),
-            ms(t.cpu),
-            ms(t.gbuffer),
-            ms(t.shadow_maps),
-            ms(t.masks),
-            ms(t.resolve)
         );
     }
     if args.sweep {

@@ -30,6 +30,27 @@ pub struct Row {
     pub image: Vec<[u8; 3]>,
 }
 
+impl Row {
+    /// The passes as printed: a number, or "all".
+    #[must_use]
+    pub fn passes_label(&self) -> String {
+        if self.passes == 0 { "all".to_string() } else { self.passes.to_string() }
+    }
+
+    /// "HDR" or "LDR".
+    #[must_use]
+    pub fn mode_label(&self) -> &'static str {
+        if self.mode == Mode::Ldr { "LDR" } else { "HDR" }
+    }
+
+    /// The frame's times in milliseconds: total, CPU, G-buffer, maps, masks, resolve.
+    #[must_use]
+    pub fn times_ms(&self) -> [f64; 6] {
+        let t = &self.times;
+        [t.total(), t.cpu, t.gbuffer, t.shadow_maps, t.masks, t.resolve].map(ms)
+    }
+}
+
 /// Composites `object` with each of `passes` in each of `modes`, `repeats` times each (the
 /// median frame by total time is kept), against `truth`.
 ///

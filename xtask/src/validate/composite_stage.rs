@@ -6,7 +6,7 @@
 use std::fmt::Write as _;
 
 use differential_composite::gpu::{GpuCompositor, GpuSettings};
-use differential_composite::measure::{Row, figure3_datasets, ms, rows};
+use differential_composite::measure::{Row, figure3_datasets, rows};
 use differential_composite::{CodeError, Mode, Session, SessionSettings, code_error};
 use glam::Vec3;
 use gpu::Gpu;
@@ -107,23 +107,20 @@ impl Compositing {
         );
         s.push_str("<table><tr><th>passes</th><th>representatives</th><th>mode</th><th>MAE (codes)</th><th>RMSE (codes)</th><th>MAE / Debevec's</th><th>ms per frame</th><th>CPU</th><th>G-buffer</th><th>maps</th><th>masks</th><th>resolve</th></tr>");
         for r in &self.rows {
-            let t = &r.times;
             let _ = write!(
                 s,
-                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.2}</td><td>{:.2}</td><td>{:.2}</td><td>{:.2}</td><td>{:.2}</td><td>{:.2}</td><td>{:.2}</td><td>{:.2}</td><td>{:.2}</td></tr>",
-                if r.passes == 0 { "all".into() } else { r.passes.to_string() },
+                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.2}</td><td>{:.2}</td><td>{:.2}</td>",
+                r.passes_label(),
                 r.reps,
-                if r.mode == Mode::Ldr { "LDR" } else { "HDR" },
+                r.mode_label(),
                 r.error.mae_changed,
                 r.error.rmse_changed,
                 r.error.mae_changed / self.debevec_error.mae_changed.max(1e-9),
-                ms(t.total()),
-                ms(t.cpu),
-                ms(t.gbuffer),
-                ms(t.shadow_maps),
-                ms(t.masks),
-                ms(t.resolve)
             );
+            for t in r.times_ms() {
+                let _ = write!(s, "<td>{t:.2}</td>");
+            }
+            s.push_str("</tr>");
         }
         s.push_str("</table><div class=\"grid\">");
         let flat = |img: &[[u8; 3]]| img.iter().flatten().copied().collect::<Vec<u8>>();
@@ -168,9 +165,5 @@ impl Compositing {
 }
 
 fn row_name(r: &Row) -> String {
-    format!(
-        "composite_{}_{}",
-        if r.passes == 0 { "all".to_string() } else { r.passes.to_string() },
-        if r.mode == Mode::Ldr { "ldr" } else { "hdr" }
-    )
+    format!("composite_{}_{}", r.passes_label(), r.mode_label().to_lowercase())
 }
