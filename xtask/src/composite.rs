@@ -167,7 +167,7 @@ pub fn run(args: &CompositeArgs) -> Result<(), String> {
     save(&beside("photo"), &c.photo_ldr)?;
     save(&beside("truth"), &truth)?;
     save(&beside("debevec"), &debevec)?;
-    save(&beside("error"), &error_image(&main.image, &truth))?;
+    save(&beside("error"), &differential_composite::metrics::error_image(&main.image, &truth))?;
     if args.json {
         let v = serde_json::json!({
             "scene": args.scene,
@@ -176,7 +176,7 @@ pub fn run(args: &CompositeArgs) -> Result<(), String> {
             "passes": main.passes,
             "representatives": main.reps,
             "occluded_sources": main.occluded_sources,
-            "mode": if main.mode == Mode::Ldr { "ldr" } else { "hdr" },
+            "mode": main.mode_label().to_lowercase(),
             "ms_per_frame": ms(main.times.total()),
             "ms_cpu": ms(main.times.cpu),
             "ms_gbuffer": ms(main.times.gbuffer),
@@ -241,15 +241,6 @@ pub fn run(args: &CompositeArgs) -> Result<(), String> {
     }
     outln!("wrote {} (and _photo, _truth, _debevec, _error)", args.out.display());
     Ok(())
-}
-
-/// |image - truth| x 8 per channel, the error map.
-fn error_image(image: &[[u8; 3]], truth: &[[u8; 3]]) -> Vec<[u8; 3]> {
-    image
-        .iter()
-        .zip(truth)
-        .map(|(a, t)| std::array::from_fn(|c| (u16::from(a[c].abs_diff(t[c])) * 8).min(255) as u8))
-        .collect()
 }
 
 /// `frames` positions along a line across the floor: per frame the traversal, the GPU

@@ -102,8 +102,18 @@ pub struct Frame {
     pub traversal: Duration,
     /// Transfers (HDR and LDR).
     pub transfers: Duration,
+    /// The object's irradiance probe.
+    pub shading: Duration,
     /// The object's SH9 irradiance at its centre (its shading).
     pub object_irradiance: Sh9,
+}
+
+impl Frame {
+    /// The frame's CPU work: traversal, transfers and the object's irradiance probe.
+    #[must_use]
+    pub fn cpu(&self) -> Duration {
+        self.traversal + self.transfers + self.shading
+    }
 }
 
 impl Compositor {
@@ -231,13 +241,17 @@ impl Compositor {
         // each representative's set: its origin source's (the sources are split by random ids)
         let sets: Vec<u8> = out.iter().map(|r| self.set_of[r.origin_source as usize]).collect();
         self.intensity_transfers(&mut out, &receiver_slots, &sets);
+        let transfers = t.elapsed();
+        let t = Instant::now();
+        let object_irradiance = self.irradiance_at(object.centre);
         Frame {
             reps: out,
             occluded_sources: occlusion.sources.len(),
             occluded_receivers: occlusion.receivers.len(),
             traversal,
-            transfers: t.elapsed(),
-            object_irradiance: self.irradiance_at(object.centre),
+            transfers,
+            shading: t.elapsed(),
+            object_irradiance,
         }
     }
 
@@ -284,7 +298,7 @@ impl Compositor {
                 / 4.0
         });
         let mut sh = Sh9::project(&probe);
-        for l in self.lights.iter().filter(|l| self.bvh.first_hit(p, l.direction).is_none()) {
+        for l in self.lights.iter().filter(|l| self.bvh.escapes(p, l.direction)) {
             let power = l.radiance * l.solid_angle;
             for (c, y) in sh.coeffs.iter_mut().zip(envmap_sphere::sh::sh9_basis(l.direction)) {
                 *c += power * y;

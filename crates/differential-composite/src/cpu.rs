@@ -89,8 +89,10 @@ pub fn composite(c: &Compositor, frame: &Frame, object: &SyntheticObject, bvh: &
                 let (mut covered, mut object_radiance) = (0u32, Vec3::ZERO);
                 for (dx, dy) in COVERAGE {
                     let (o, d) = rays.ray(x as f32 + dx, y as f32 + dy);
-                    let behind = c.model_bvh().first_hit(o, d).map_or(f32::INFINITY, |h| h.1);
-                    if let Some(hit) = bvh.seen.intersect(o, d, behind) {
+                    // the object's few hundred triangles first: the model is traced only where
+                    // a ray finds the object, to see whether something stands in front of it
+                    let Some(hit) = bvh.seen.intersect(o, d, f32::INFINITY) else { continue };
+                    if c.model_bvh().first_hit(o, d).is_none_or(|m| m.1 > hit.t) {
                         let n = if hit.shading_normal.dot(d) > 0.0 { -hit.shading_normal } else { hit.shading_normal };
                         covered += 1;
                         object_radiance += shade(n);

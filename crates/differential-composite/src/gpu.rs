@@ -41,7 +41,7 @@ impl Default for GpuSettings {
 /// Where a GPU frame's time went (wall clock on the CPU, each stage waited for).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct FrameTimes {
-    /// Traversal, representative set and transfers (CPU).
+    /// Traversal, representative set, transfers and the object's irradiance probe (CPU).
     pub cpu: Duration,
     /// The G-buffer of the reconstruction with the object.
     pub gbuffer: Duration,
@@ -184,7 +184,7 @@ impl GpuCompositor {
         settings: &GpuSettings,
     ) -> Result<(Vec<[u8; 3]>, FrameTimes), GpuError> {
         let (w, h) = self.size;
-        let mut times = FrameTimes { cpu: frame.traversal + frame.transfers, ..FrameTimes::default() };
+        let mut times = FrameTimes { cpu: frame.cpu(), ..FrameTimes::default() };
         // the G-buffer of the reconstruction with the object (its index: after the patches)
         let t = Instant::now();
         let mut scene = c.model.to_scene();

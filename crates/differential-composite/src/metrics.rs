@@ -48,6 +48,16 @@ pub fn code_error(image: &[[u8; 3]], truth: &[[u8; 3]], photo: &[[u8; 3]]) -> Co
     }
 }
 
+/// |image - truth| x 8 per channel: the error map the command and the report write.
+#[must_use]
+pub fn error_image(image: &[[u8; 3]], truth: &[[u8; 3]]) -> Vec<[u8; 3]> {
+    image
+        .iter()
+        .zip(truth)
+        .map(|(a, t)| std::array::from_fn(|c| (u16::from(a[c].abs_diff(t[c])) * 8).min(255) as u8))
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -65,5 +75,6 @@ mod tests {
         assert!((e.mae_changed - 1.0).abs() < 1e-12 && (e.rmse_changed - 3.0f64.sqrt()).abs() < 1e-12);
         assert!((e.mae - 5.0 / 12.0).abs() < 1e-12 && (e.rmse - (13.0f64 / 12.0).sqrt()).abs() < 1e-12);
         assert_eq!(code_error(&truth, &truth, &photo), CodeError { changed: 1, ..CodeError::default() });
+        assert_eq!(error_image(&image, &truth)[3], [0, 0, 16]);
     }
 }

@@ -118,8 +118,7 @@ impl Session {
     /// # Errors
     /// As [`crate::offline::truth`].
     pub fn truth(&self, object: &SyntheticObject) -> Result<Vec<[u8; 3]>, CompositeError> {
-        let settings = PhotoSettings { seed: self.settings.photo.seed, ..self.settings.photo };
-        let hdr = crate::offline::truth(&self.real, object, self.map.as_ref(), &settings)?;
+        let hdr = crate::offline::truth(&self.real, object, self.map.as_ref(), &self.settings.photo)?;
         Ok(hdr.iter().map(|c| self.compositor.response.apply(*c)).collect())
     }
 

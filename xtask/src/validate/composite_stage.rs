@@ -125,12 +125,7 @@ impl Compositing {
         s.push_str("</table><div class=\"grid\">");
         let flat = |img: &[[u8; 3]]| img.iter().flatten().copied().collect::<Vec<u8>>();
         let composite = self.rows.iter().find(|r| r.passes == 50 && r.mode == Mode::Hdr).unwrap_or(&self.rows[0]);
-        let error: Vec<u8> = composite
-            .image
-            .iter()
-            .zip(&self.truth)
-            .flat_map(|(a, t)| std::array::from_fn::<u8, 3, _>(|c| (u16::from(a[c].abs_diff(t[c])) * 8).min(255) as u8))
-            .collect();
+        let error = flat(&differential_composite::metrics::error_image(&composite.image, &self.truth));
         for (name, bytes) in [
             ("composite_photo", flat(&self.photo)),
             ("composite_truth", flat(&self.truth)),
