@@ -436,12 +436,7 @@ impl Thresholds {
     /// limits at all (another map or scene) are only reported.
     #[must_use]
     pub fn check(&self, measured: &BTreeMap<String, f64>) -> (Vec<String>, usize) {
-        let run_of = |k: &str| k.split_once(':').map_or(k, |(run, _)| run).to_string();
-        let row_of = |k: &str| {
-            let row = k.split_once(':').map_or(k, |(_, rest)| rest);
-            row.rsplit_once('.').map_or(row, |(row, _)| row).to_string()
-        };
-        let runs: BTreeSet<String> = self.limits.keys().map(|k| run_of(k)).collect();
+        let runs: BTreeSet<&str> = self.limits.keys().map(|k| key_parts(k).0).collect();
         let mut failures = Vec::new();
         let mut checked = 0;
         for (k, v) in measured {
@@ -453,15 +448,23 @@ impl Thresholds {
                         failures.push(format!("{k} = {v:.5} exceeds {t}"));
                     }
                 }
-                None if runs.contains(&run_of(k)) && !self.report_only.contains(&row_of(k)) => failures.push(format!(
-                    "{k} = {v:.5} has no threshold in {}: add one, or list its row under \"report_only\"",
-                    self.name
-                )),
+                None if runs.contains(key_parts(k).0) && !self.report_only.contains(key_parts(k).1) => {
+                    failures.push(format!(
+                        "{k} = {v:.5} has no threshold in {}: add one, or list its row under \"report_only\"",
+                        self.name
+                    ))
+                }
                 None => {}
             }
         }
         (failures, checked)
     }
+}
+
+/// (run, row) of a measured key `run:row.metric`.
+fn key_parts(key: &str) -> (&str, &str) {
+    let (run, rest) = key.split_once(':').unwrap_or((key, ""));
+    (run, rest.rsplit_once('.').map_or(rest, |(row, _)| row))
 }
 
 /// The thresholds of `path`, or the embedded checked-in ones.
@@ -498,8 +501,7 @@ pub fn parse_thresholds(text: &str, name: &str) -> Result<Thresholds, String> {
         let list = list.as_array().ok_or_else(|| format!("{name}: \"report_only\" is not a list"))?;
         for k in list {
             let k = k.as_str().ok_or_else(|| format!("{name}: a \"report_only\" entry is not a string"))?;
-            if limits.keys().any(|key| key.split_once(':').is_some_and(|(_, rest)| rest.starts_with(&format!("{k}."))))
-            {
+            if limits.keys().any(|key| key_parts(key).1 == k) {
                 return Err(format!("{name}: row {} has thresholds and is listed as report_only", one_line(k)));
             }
             report_only.insert(k.to_string());
