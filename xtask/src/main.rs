@@ -22,6 +22,7 @@ mod scene;
 mod shafts;
 mod soft_shadows;
 mod test;
+mod trade;
 mod validate;
 
 use clap::{Parser, Subcommand};
@@ -194,6 +195,11 @@ enum Command {
     /// _error beside it) and prints the error in codes against the path-traced truth and
     /// Debevec's offline differential rendering, and the time per frame.
     Composite(composite::CompositeArgs),
+    /// The speed/accuracy trade: every setting of a preset (extraction, K, shadow technique and
+    /// its knobs, paper 001's split) on scenes x maps, its GPU time per frame and its error
+    /// against the env-direct truth; OUT/trade.csv, trade.json and report.html (plots, Pareto
+    /// fronts, the chooser's picks). `trade merge DIR... --out DIR` joins shards.
+    Trade(trade::TradeArgs),
     /// Print an environment map's size, format, luminance, power and SH9 coefficients.
     Info {
         /// The map (.exr or .hdr).
@@ -234,6 +240,7 @@ fn main() -> ExitCode {
             shafts::run(&shafts::ShaftsArgs { scene: &scene, json, settings, sweep, photo, out: &out })
         }
         Command::Composite(args) => composite::run(&args),
+        Command::Trade(args) => trade::run(&args),
         Command::SoftShadows { scenes, size, adapter, out } => {
             soft_shadows::run(&scenes, size, adapter.as_deref(), &out)
         }

@@ -60,6 +60,11 @@ pub struct ValidateArgs {
     /// wedges (8 times the shadow work of a row: not part of the default run).
     #[arg(long)]
     pub interleaved: bool,
+    /// Print the GPU row with the least RMSE whose time (this run's wall time on this adapter)
+    /// fits in MS milliseconds: `budget: MS ms -> ROW (ms M, rmse R)`; fails when none fits,
+    /// naming the cheapest.
+    #[arg(long, value_name = "MS")]
+    pub budget_ms: Option<f64>,
 }
 
 /// `validate`'s extraction: paper 001's emissive split with our options (0.45x median cut's
@@ -369,6 +374,9 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
     if let (Some(g), Some(t)) = (rmse_of("gpu_wedges"), rmse_of("lights_ray_traced")) {
         outln!("  gpu_wedges / lights_ray_traced RMSE: {:.2}x (goal 1.2x)", g / t);
     }
+    if let Some(budget) = args.budget_ms {
+        outln!("{}", budget_line(&rows, budget)?);
+    }
     for m in &mask_rows {
         outln!("  room {:<26} {:>7.3} % of pixels disagree  {:>7.2} ms", m.name, m.disagreement * 100.0, m.gpu_ms);
     }
@@ -510,6 +518,20 @@ pub fn parse_thresholds(text: &str, name: &str) -> Result<Thresholds, String> {
     Ok(Thresholds { limits, report_only, name: name.to_string() })
 }
 
+/// The chooser over this run's GPU rows (ray-traced visibility is not a frame technique, and a
+/// row without a time, `gpu_unshadowed`, cannot be placed: both are left out): `budget: MS ms -> ROW (ms M, rmse R)`, or an error naming the cheapest row.
+fn budget_line(rows: &[Row], budget: f64) -> Result<String, String> {
+    let points: Vec<trade::Point> = rows
+        .iter()
+        .filter(|r| r.name.starts_with("gpu_") && r.name != "gpu_traced_visibility" && r.seconds > 0.0)
+        .filter_map(|r| {
+            Some(trade::Point { setting: r.name.clone(), ms: r.seconds * 1e3, rmse: r.rmse?, flip: r.flip? })
+        })
+        .collect();
+    let p = trade::choose(&points, budget).map_err(|e| format!("--budget-ms: {e}"))?;
+    Ok(format!("budget: {budget} ms -> {} (ms {:.1}, rmse {:.4})", p.setting, p.ms, p.rmse))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -517,6 +539,34 @@ mod tests {
     fn thresholds() -> Thresholds {
         let text = r#"{"thresholds": {"s@m:a.rmse": 0.1, "s@m:b.rmse": 0.2}, "report_only": ["c"]}"#;
         parse_thresholds(text, "t.json").unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    fn row(name: &str, seconds: f64, rmse: f64) -> Row {
+        Row {
+            name: name.into(),
+            what: String::new(),
+            image: Vec::new(),
+            seconds,
+            rmse: Some(rmse),
+            flip: Some(rmse),
+            rmse_vs_lights: None,
+        }
+    }
+
+    #[test]
+    fn the_budget_line_names_the_best_row_that_fits() {
+        let rows = [
+            row("lights_ray_traced", 0.5, 0.001),
+            row("gpu_shadow_maps", 2.0, 0.03),
+            row("gpu_wedges", 9.0, 0.012),
+            row("gpu_traced_visibility", 1.0, 0.011),
+            row("gpu_unshadowed", 0.0, 0.1),
+        ];
+        let line = budget_line(&rows, 4000.0).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(line, "budget: 4000 ms -> gpu_shadow_maps (ms 2000.0, rmse 0.0300)");
+        assert!(budget_line(&rows, 1e5).is_ok_and(|l| l.contains("-> gpu_wedges")));
+        let e = budget_line(&rows, 100.0).expect_err("nothing fits 100 ms");
+        assert!(e.contains("gpu_shadow_maps") && e.contains("2000.000 ms"), "{e}");
     }
 
     fn measured(pairs: &[(&str, f64)]) -> BTreeMap<String, f64> {

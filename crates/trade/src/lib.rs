@@ -1,0 +1,85 @@
+//! The speed/accuracy trade, measured and chosen from.
+//!
+//! Every frame the toolkit can draw is a [`Setting`] (extraction method and K, shadow technique
+//! and its knobs, paper 001's split, Weber skipping). [`measure`] times a setting's GPU frame and
+//! takes its error against the `env-direct` truth; [`Run`] holds the measurements and writes
+//! `trade.csv` / `trade.json`; [`front`] marks Pareto fronts and [`choose`] picks the least error
+//! within a time budget; [`Shard`] splits a map library over machines and [`merge`] joins the
+//! shards' runs; [`report::html`] draws the plots.
+//!
+//! **Architecture invariant:** techniques are reached only through `gpu::ShadowTechnique` and
+//! extraction only through `light_extract::extractor`: a new technique adds a [`Shadow`] value
+//! and one line in [`measure::technique`], nothing else here changes. Library code: no printing,
+//! progress goes to a callback.
+
+pub mod front;
+pub mod measure;
+pub mod report;
+pub mod setting;
+pub mod shard;
+pub mod table;
+
+pub use front::{ChooseError, Measurement, Point, choose, front as pareto_front, mark_fronts, overall, pareto};
+pub use measure::{Case, Passes, Plan, measure};
+pub use setting::{BEST_METHOD, Preset, Setting, Shadow};
+pub use shard::{Shard, ShardError};
+pub use table::{Run, RunConfig, merge};
+
+use std::path::PathBuf;
+
+/// What can go wrong measuring, writing, reading or merging a trade.
+#[derive(Debug, thiserror::Error)]
+pub enum TradeError {
+    /// A file or folder could not be read or written.
+    #[error("{path}: {source}")]
+    Io {
+        /// The path.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// A JSON file that is not a trade run.
+    #[error("{path}: not a trade run: {message}")]
+    Json {
+        /// The file.
+        path: PathBuf,
+        /// The parser's message.
+        message: String,
+    },
+    /// Shards measured with different configurations cannot merge.
+    #[error("{path}: measured differently from {other}: {what}")]
+    Mismatch {
+        /// The shard's folder.
+        path: PathBuf,
+        /// The first shard's folder.
+        other: PathBuf,
+        /// The differing configurations.
+        what: String,
+    },
+    /// The same shard or measurement twice in a merge.
+    #[error("{path}: {what} is already in the merge")]
+    Duplicate {
+        /// The shard's folder.
+        path: PathBuf,
+        /// What is repeated.
+        what: String,
+    },
+    /// A merge of nothing.
+    #[error("nothing to merge: give at least one folder with a trade.json")]
+    NothingToMerge,
+    /// An unknown scene.
+    #[error("scene: {0}")]
+    Scene(String),
+    /// An unknown or failing extraction method.
+    #[error("extraction method: {0}")]
+    Method(String),
+    /// GPU failures.
+    #[error("GPU: {0}")]
+    Gpu(#[from] gpu::GpuError),
+    /// A frame that could not be made.
+    #[error("render: {0}")]
+    Render(String),
+    /// A plot that could not be drawn.
+    #[error("plot: {0}")]
+    Plot(String),
+}

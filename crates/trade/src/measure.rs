@@ -1,0 +1,294 @@
+//! Measuring a setting: its frame on the GPU (time) against the `env-direct` truth (error).
+//! Techniques come through `gpu::ShadowTechnique` and extraction through
+//! `light_extract::extractor`; nothing here knows one technique from another beyond building it
+//! from its [`Shadow`] value.
+
+use crate::TradeError;
+use crate::front::Measurement;
+use crate::setting::{Setting, Shadow};
+use envmap_sphere::EnvMap;
+use glam::Vec3;
+use gpu::{
+    Background, GBufferPass, Gpu, JointBilateral, LightShape, PrefilterSettings, Receivers, RotatedGrid, SceneGeometry,
+    ShadeLight, ShadeParams, ShadingPass, ShadowPassReport, ShadowTechnique, SpecularAmbient, SplitFrame, SplitPasses,
+    SplitSettings, UpsamplePass, Visibility, WEBER_FRACTION, render_split, render_visibility, weber_negligible,
+};
+use light_extract::Decomposition;
+use penumbra_wedge::{WedgeSettings, Wedges};
+use ref_tracer::metrics::{FlipTonemap, flip, rmse};
+use ref_tracer::{EnvLight, Integrator, RenderSettings, SceneBvh, Strategy};
+use shadowmap_paraboloid::{MapTechnique, Technique};
+use std::collections::HashMap;
+use std::time::{Duration, Instant};
+
+/// How a run measures.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Plan {
+    /// Output image size.
+    pub size: (u32, u32),
+    /// Samples per pixel of the truth.
+    pub truth_spp: u32,
+    /// Frames timed per setting (the median is kept).
+    pub repeats: u32,
+    /// GPU frames on a rotated grid of k² + 1 samples per pixel (`gpu::RotatedGrid`), as
+    /// `validate`'s: the ground's far edge aliases otherwise and its error hides the shadows'.
+    pub supersample: u32,
+}
+
+impl Plan {
+    /// `--quick`: 160 x 120, 64 spp, one frame timed after the warm-up frame (its times
+    /// are for CI, not for reading).
+    pub const QUICK: Plan = Plan { size: (160, 120), truth_spp: 64, repeats: 1, supersample: 2 };
+    /// The default run: 320 x 240, 128 spp, 5 repeats.
+    pub const DEFAULT: Plan = Plan { size: (320, 240), truth_spp: 128, repeats: 5, supersample: 2 };
+}
+
+/// One scene under one map, with its truth.
+pub struct Case {
+    /// Built-in scene at the plan's size.
+    pub scene: scene::Scene,
+    /// Map name for the tables.
+    pub map_name: String,
+    /// The map.
+    pub map: EnvMap,
+    truth: Vec<Vec3>,
+    truth_noise: f64,
+    tonemap: FlipTonemap,
+}
+
+impl Case {
+    /// Renders the truth of `scene_name` under `map` twice with independent seeds: the first
+    /// is the truth, their difference its noise.
+    ///
+    /// # Errors
+    /// An unknown scene.
+    pub fn new(scene_name: &str, map_name: &str, map: EnvMap, plan: &Plan) -> Result<Self, TradeError> {
+        let mut scene = scene::Scene::builtin(scene_name).map_err(|e| TradeError::Scene(e.to_string()))?;
+        (scene.camera.width, scene.camera.height) = plan.size;
+        let bvh = SceneBvh::new(&scene);
+        let env = EnvLight::new(&map);
+        let render = |seed| {
+            let settings = RenderSettings { spp: plan.truth_spp, seed, aovs: false, ..RenderSettings::default() };
+            ref_tracer::render(&scene, &bvh, Some(&env), &Integrator::EnvDirect(Strategy::Mis), &settings, &|_, _| {})
+                .color
+        };
+        let (truth, second) = (render(1), render(2));
+        let truth_noise = rmse(&truth, &second) / std::f64::consts::SQRT_2;
+        let tonemap = FlipTonemap::for_reference(&truth);
+        Ok(Self { scene, map_name: map_name.into(), map, truth, truth_noise, tonemap })
+    }
+
+    /// The truth image.
+    #[must_use]
+    pub fn truth(&self) -> &[Vec3] {
+        &self.truth
+    }
+}
+
+/// GPU passes built once and shared by every setting.
+pub struct Passes {
+    gbuffer: GBufferPass,
+    shading: ShadingPass,
+    upsample: UpsamplePass,
+}
+
+impl Passes {
+    /// Builds the passes.
+    ///
+    /// # Errors
+    /// GPU failures.
+    pub fn new(gpu: &Gpu) -> Result<Self, TradeError> {
+        Ok(Self { gbuffer: GBufferPass::new(gpu), shading: ShadingPass::new(gpu)?, upsample: UpsamplePass::new(gpu) })
+    }
+}
+
+/// The technique of `shadow` for `scene`, `None` for [`Shadow::None`].
+///
+/// # Errors
+/// GPU failures.
+pub fn technique(
+    gpu: &Gpu,
+    scene: &scene::Scene,
+    shadow: &Shadow,
+) -> Result<Option<Box<dyn ShadowTechnique>>, TradeError> {
+    Ok(match (shadow, shadow.map_settings()) {
+        (Shadow::None, _) => None,
+        (Shadow::Wedges, _) => Some(Box::new(Wedges::new(gpu, scene, WedgeSettings::default()))),
+        (_, Some((settings, n))) => {
+            Some(Box::new(MapTechnique::new(gpu, scene, Technique::Orthographic, settings, n)?))
+        }
+        (_, None) => None,
+    })
+}
+
+/// A decomposition and its CPU time, per (method, K).
+type Extractions = HashMap<(String, usize), (Decomposition, f64)>;
+
+fn extract(cache: &mut Extractions, map: &EnvMap, method: &str, k: usize) -> Result<(Decomposition, f64), TradeError> {
+    if let Some(d) = cache.get(&(method.to_string(), k)) {
+        return Ok(d.clone());
+    }
+    let extractor = light_extract::extractor(method, k).ok_or_else(|| TradeError::Method(method.to_string()))?;
+    let t = Instant::now();
+    let mut d = extractor.extract(map).map_err(|e| TradeError::Method(format!("{method}: {e}")))?;
+    let ms = t.elapsed().as_secs_f64() * 1e3;
+    d.sort_directs_first();
+    cache.insert((method.to_string(), k), (d.clone(), ms));
+    Ok((d, ms))
+}
+
+/// What a frame needs that does not depend on the setting's shadows.
+struct FrameInput<'a> {
+    passes: &'a Passes,
+    geometry: &'a SceneGeometry,
+    camera: &'a scene::Camera,
+    decomposition: &'a Decomposition,
+    background: &'a Background,
+    specular: Option<&'a SpecularAmbient>,
+}
+
+/// One frame: G-buffer, shadows, shading; the image left on the GPU and the shadow reports.
+fn frame(
+    gpu: &Gpu,
+    input: &FrameInput,
+    setting: &Setting,
+    technique: Option<&dyn ShadowTechnique>,
+) -> Result<(wgpu::Texture, Vec<ShadowPassReport>), TradeError> {
+    let d = input.decomposition;
+    let lights: Vec<ShadeLight> = d.lights.iter().map(|l| ShadeLight::from(&l.light)).collect();
+    let shapes: Vec<LightShape> = d.lights.iter().map(|l| LightShape::from(&l.light)).collect();
+    let gb = input.passes.gbuffer.render(gpu, input.geometry, input.camera)?;
+    let (w, h) = gb.size();
+    let vis = Visibility::new(gpu, w, h, lights.len().max(1) as u32)?;
+    let params = ShadeParams {
+        lights: &lights,
+        ambient: Some(&d.ambient_sh),
+        background: Some(input.background),
+        specular_ambient: input.specular,
+    };
+    let Some(technique) = technique else {
+        let image = input.passes.shading.render_texture(gpu, input.geometry, &gb, &params, &vis)?;
+        return Ok((image, Vec::new()));
+    };
+    let points = gb.read_points(gpu)?;
+    let receivers = Receivers::new(&gb, &points);
+    let negligible = if setting.weber {
+        weber_negligible(&receivers, &lights, Some(&d.ambient_sh), WEBER_FRACTION)
+    } else {
+        Vec::new()
+    };
+    let directs = if setting.indirect_scale > 1 { d.directs() } else { lights.len() };
+    let mut reports = render_visibility(gpu, technique, &receivers, &shapes[..directs], &negligible, &vis)?;
+    if directs == lights.len() {
+        let image = input.passes.shading.render_texture(gpu, input.geometry, &gb, &params, &vis)?;
+        return Ok((image, reports));
+    }
+    let split = render_split(
+        gpu,
+        &SplitPasses {
+            gbuffer: &input.passes.gbuffer,
+            shading: &input.passes.shading,
+            upsample: &input.passes.upsample,
+        },
+        input.geometry,
+        (&receivers, &vis),
+        &SplitFrame {
+            lights: &lights,
+            shapes: &shapes,
+            directs,
+            ambient: Some(&d.ambient_sh),
+            specular_ambient: input.specular,
+            background: Some(input.background),
+        },
+        technique,
+        &SplitSettings { indirect_scale: setting.indirect_scale, upsample: JointBilateral::PAPER },
+    )?;
+    reports.extend(split.indirect_reports);
+    Ok((split.texture, reports))
+}
+
+/// Measures every setting on `case`: one warm-up frame, then `plan.repeats` frames timed
+/// (median), the last one read back and compared with the truth. `progress` is told each measurement as it is made.
+///
+/// # Errors
+/// An unknown method; GPU failures.
+pub fn measure(
+    gpu: &Gpu,
+    passes: &Passes,
+    case: &Case,
+    settings: &[Setting],
+    plan: &Plan,
+    progress: &mut dyn FnMut(&Measurement),
+) -> Result<Vec<Measurement>, TradeError> {
+    let grid = RotatedGrid::new(&case.scene.camera, plan.supersample.max(1));
+    let mut scene = case.scene.clone();
+    scene.camera = *grid.camera();
+    let geometry = SceneGeometry::upload(gpu, &scene)?;
+    let background = Background::upload(gpu, &case.map)?;
+    let glossy = scene.objects.iter().any(|o| o.material.specular.is_some());
+    let (w, h) = (case.scene.camera.width, case.scene.camera.height);
+    let mut cache = Extractions::new();
+    let mut specular_cache: HashMap<(String, usize), Option<SpecularAmbient>> = HashMap::new();
+    let mut out = Vec::new();
+    for setting in settings {
+        let (d, extract_ms) = extract(&mut cache, &case.map, &setting.method, setting.lights)?;
+        let key = (setting.method.clone(), setting.lights);
+        if !specular_cache.contains_key(&key) {
+            let s =
+                if glossy { Some(SpecularAmbient::new(gpu, &d.ambient, &PrefilterSettings::default())?) } else { None };
+            specular_cache.insert(key.clone(), s);
+        }
+        let specular = specular_cache.get(&key).and_then(Option::as_ref);
+        let technique = technique(gpu, &scene, &setting.shadow)?;
+        let input = FrameInput {
+            passes,
+            geometry: &geometry,
+            camera: &scene.camera,
+            decomposition: &d,
+            background: &background,
+            specular,
+        };
+        // one frame untimed first: pipelines compile and buffers grow on first use
+        let mut last = Some(frame(gpu, &input, setting, technique.as_deref())?);
+        let mut times = Vec::new();
+        for _ in 0..plan.repeats.max(1) {
+            let t = Instant::now();
+            let (image, reports) = frame(gpu, &input, setting, technique.as_deref())?;
+            times.push(t.elapsed());
+            last = Some((image, reports));
+        }
+        times.sort();
+        let (image, reports) = last.ok_or_else(|| TradeError::Render("no frame".into()))?;
+        let image = grid.resolve(&gpu::read_hdr(gpu, &image)?);
+        let (_, shadowed, _, _) = gpu::totals(&reports);
+        let mut skipped: Vec<(String, usize)> = Vec::new();
+        for why in reports.iter().filter_map(|r| r.skipped.clone()) {
+            match skipped.iter_mut().find(|(w, _)| *w == why) {
+                Some((_, n)) => *n += 1,
+                None => skipped.push((why, 1)),
+            }
+        }
+        let m = Measurement {
+            setting: setting.name(),
+            knobs: setting.clone(),
+            scene: case.scene.name.clone(),
+            map: case.map_name.clone(),
+            ms: median_ms(&times),
+            clock: format!("wall time (submit + wait) on {}", gpu.describe()),
+            extract_ms,
+            rmse: rmse(&case.truth, &image),
+            flip: flip(&case.truth, &image, w, h, &case.tonemap),
+            truth_noise: case.truth_noise,
+            shadowed,
+            skipped,
+            pareto: false,
+        };
+        progress(&m);
+        out.push(m);
+    }
+    Ok(out)
+}
+
+fn median_ms(times: &[Duration]) -> f64 {
+    times.get(times.len() / 2).map_or(f64::NAN, |t| t.as_secs_f64() * 1e3)
+}

@@ -1,0 +1,184 @@
+//! The HTML report: error against ms per frame, one plot per scene and map and one over all,
+//! the Pareto front drawn and its settings named, and the tables behind them.
+
+use crate::TradeError;
+use crate::front::{Point, front, overall};
+use crate::table::Run;
+use plotters::prelude::*;
+use std::fmt::Write as _;
+
+/// An SVG plot of RMSE against ms (log time, linear error) with the front drawn and its points named.
+///
+/// # Errors
+/// [`TradeError::Plot`] when plotters fails (e.g. no finite point).
+pub fn plot_svg(title: &str, points: &[Point]) -> Result<String, TradeError> {
+    let finite: Vec<&Point> =
+        points.iter().filter(|p| p.ms > 0.0 && p.rmse > 0.0 && p.ms.is_finite() && p.rmse.is_finite()).collect();
+    let plot_err = |e: &dyn std::fmt::Display| TradeError::Plot(format!("{title}: {e}"));
+    if finite.is_empty() {
+        return Err(plot_err(&"no point with a positive, finite time and error"));
+    }
+    let range = |f: &dyn Fn(&Point) -> f64| {
+        let lo = finite.iter().map(|p| f(p)).fold(f64::INFINITY, f64::min);
+        let hi = finite.iter().map(|p| f(p)).fold(0.0, f64::max);
+        (lo / 1.5)..(hi * 1.5)
+    };
+    let xr = range(&|p| p.ms);
+    // linear in error (a log axis over one decade gets one label), from zero
+    let yr = 0.0..finite.iter().map(|p| p.rmse).fold(0.0, f64::max) * 1.15;
+    let f = front(points);
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (760, 480)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| plot_err(&e))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 18))
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(64)
+            .build_cartesian_2d(xr.log_scale(), yr)
+            .map_err(|e| plot_err(&e))?;
+        chart
+            .configure_mesh()
+            .x_desc("ms per frame")
+            .y_desc("RMSE against env-direct")
+            .x_labels(8)
+            .y_labels(8)
+            .max_light_lines(2)
+            .x_label_formatter(&|x| short_number(*x))
+            .y_label_formatter(&|y| short_number(*y))
+            .draw()
+            .map_err(|e| plot_err(&e))?;
+        chart
+            .draw_series(finite.iter().map(|p| Circle::new((p.ms, p.rmse), 4, RGBColor(120, 120, 120).filled())))
+            .map_err(|e| plot_err(&e))?
+            .label("setting")
+            .legend(|(x, y)| Circle::new((x, y), 4, RGBColor(120, 120, 120).filled()));
+        // the front as a staircase: a setting is worth its time until the next one is reached
+        let mut steps = Vec::new();
+        for (k, p) in f.iter().enumerate() {
+            steps.push((p.ms, p.rmse));
+            if let Some(next) = f.get(k + 1) {
+                steps.push((next.ms, p.rmse));
+            }
+        }
+        chart
+            .draw_series(LineSeries::new(steps, RED.stroke_width(2)))
+            .map_err(|e| plot_err(&e))?
+            .label("Pareto front")
+            .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], RED.stroke_width(2)));
+        chart
+            .draw_series(f.iter().map(|p| {
+                EmptyElement::at((p.ms, p.rmse))
+                    + Circle::new((0, 0), 5, RED.filled())
+                    + Text::new(label(&p.setting), (6, -14), ("sans-serif", 11))
+            }))
+            .map_err(|e| plot_err(&e))?;
+        chart
+            .configure_series_labels()
+            .border_style(BLACK)
+            .background_style(WHITE.mix(0.8))
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(|e| plot_err(&e))?;
+        root.present().map_err(|e| plot_err(&e))?;
+    }
+    Ok(svg)
+}
+
+/// An axis label with about two significant digits: 1200, 35, 4.5, 0.012.
+fn short_number(x: f64) -> String {
+    let digits = if x <= 0.0 || !x.is_finite() { 0 } else { (1.0 - x.log10().floor()).max(0.0) as usize };
+    format!("{x:.digits$}")
+}
+
+/// A setting's name for a plot label: the best method's name left out (the report says so).
+fn label(setting: &str) -> String {
+    setting.strip_prefix(&format!("{}/", crate::BEST_METHOD)).unwrap_or(setting).to_string()
+}
+
+fn escape(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
+}
+
+/// The report of `run`, with the chooser's picks for `budgets` (ms) over all scenes and maps.
+///
+/// # Errors
+/// A plot that cannot be drawn.
+pub fn html(run: &Run, budgets: &[f64]) -> Result<String, TradeError> {
+    let c = &run.config;
+    let mut h = String::from(
+        "<!doctype html><html><head><meta charset=\"utf-8\"><title>envshadow: the trade</title><style>body{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #ccc;padding:3px 8px;font-size:13px}th{background:#f2f2f2}td.n{text-align:right}tr.front{background:#fff0f0}</style></head><body>",
+    );
+    let _ = write!(
+        h,
+        "<h1>The trade: time against error</h1><p>{} x {}, truth: ref-tracer <code>env-direct</code> at {} spp; GPU frames on a rotated grid of {} samples per pixel; times are the median of {} frames (G-buffer, shadows, shading; GPU work waited for) on <b>{}</b>. Preset: {}. Shards: {}. Plot labels leave out the method when it is the best one, <code>{}</code>.</p>",
+        c.size.0,
+        c.size.1,
+        c.truth_spp,
+        c.supersample * c.supersample + 1,
+        c.repeats,
+        escape(&c.adapter),
+        escape(&c.preset),
+        escape(&run.shards.join(", ")),
+        crate::BEST_METHOD
+    );
+    let all = overall(&run.rows);
+    if !all.is_empty() {
+        h.push_str("<h2>Over all scenes and maps</h2><p>Mean ms and mean RMSE of each setting measured on every scene and map.</p>");
+        h.push_str(&plot_svg("all scenes and maps", &all)?);
+        h.push_str("<h3>The front</h3><table><tr><th>setting</th><th>ms</th><th>RMSE</th><th>FLIP</th></tr>");
+        for p in front(&all) {
+            let _ = write!(
+                h,
+                "<tr><td>{}</td><td class=n>{:.3}</td><td class=n>{:.5}</td><td class=n>{:.4}</td></tr>",
+                escape(&p.setting),
+                p.ms,
+                p.rmse,
+                p.flip
+            );
+        }
+        h.push_str("</table><h3>The chooser</h3><table><tr><th>budget</th><th>choice</th></tr>");
+        for b in budgets {
+            let cell = match crate::front::choose(&all, *b) {
+                Ok(p) => format!("{} ({:.3} ms, RMSE {:.5})", escape(&p.setting), p.ms, p.rmse),
+                Err(e) => escape(&e.to_string()),
+            };
+            let _ = write!(h, "<tr><td class=n>{b} ms</td><td>{cell}</td></tr>");
+        }
+        h.push_str("</table>");
+    }
+    let mut cases: Vec<(&str, &str)> = run.rows.iter().map(|r| (r.scene.as_str(), r.map.as_str())).collect();
+    cases.dedup();
+    for (scene, map) in cases {
+        let rows: Vec<_> = run.rows.iter().filter(|r| r.scene == scene && r.map == map).collect();
+        let points: Vec<Point> =
+            rows.iter().map(|r| Point { setting: r.setting.clone(), ms: r.ms, rmse: r.rmse, flip: r.flip }).collect();
+        let noise = rows.first().map_or(0.0, |r| r.truth_noise);
+        let _ =
+            write!(h, "<h2>{} under {}</h2><p>The truth's own noise: RMSE {noise:.5}.</p>", escape(scene), escape(map));
+        h.push_str(&plot_svg(&format!("{scene} / {map}"), &points)?);
+        h.push_str("<table><tr><th>setting</th><th>ms</th><th>clock</th><th>RMSE</th><th>FLIP</th><th>shadowed</th><th>skipped</th><th>extraction ms (CPU)</th></tr>");
+        let mut sorted = rows.clone();
+        sorted.sort_by(|a, b| a.ms.total_cmp(&b.ms));
+        for r in sorted {
+            let skipped: Vec<String> = r.skipped.iter().map(|(why, n)| format!("{n}: {why}")).collect();
+            let _ = write!(
+                h,
+                "<tr{}><td>{}</td><td class=n>{:.3}</td><td>{}</td><td class=n>{:.5}</td><td class=n>{:.4}</td><td class=n>{}</td><td>{}</td><td class=n>{:.1}</td></tr>",
+                if r.pareto { " class=front" } else { "" },
+                escape(&r.setting),
+                r.ms,
+                escape(&r.clock),
+                r.rmse,
+                r.flip,
+                r.shadowed,
+                escape(&skipped.join("; ")),
+                r.extract_ms
+            );
+        }
+        h.push_str("</table>");
+    }
+    h.push_str("</body></html>\n");
+    Ok(h)
+}

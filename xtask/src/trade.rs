@@ -1,0 +1,176 @@
+//! `cargo xtask trade`: every setting of a preset on scenes x maps, timed on the GPU and
+//! compared with the `env-direct` truth (the `trade` crate measures); DIR/trade.csv,
+//! DIR/trade.json and DIR/report.html. `trade merge` joins shards' outputs.
+
+use clap::{Args, Subcommand};
+use std::path::{Path, PathBuf};
+use trade::{Case, Passes, Plan, Preset, Run, RunConfig, Shard};
+
+/// Budgets (ms per frame) the report's chooser answers.
+pub const REPORT_BUDGETS: [f64; 3] = [1.0, 4.0, 16.0];
+
+/// The default run's scenes: validate's, the glossy one, paper 000's two.
+const SCENES: [&str; 4] = ["spheres_box", "glossy_set", "three_boxes", "column"];
+/// `--quick`'s scenes.
+const QUICK_SCENES: [&str; 2] = ["spheres_box", "three_boxes"];
+
+/// `cargo xtask trade`.
+#[derive(Args)]
+#[command(args_conflicts_with_subcommands = true)]
+pub struct TradeArgs {
+    #[command(subcommand)]
+    merge: Option<TradeCommand>,
+    /// The quick preset (7 settings, 160x120, the default map, spheres_box and three_boxes), for
+    /// CI.
+    #[arg(long)]
+    quick: bool,
+    /// Comma-separated built-in scenes; spheres_box, glossy_set, three_boxes and column when
+    /// absent (with --quick: spheres_box and three_boxes).
+    #[arg(long, value_delimiter = ',')]
+    scenes: Vec<String>,
+    /// Comma-separated maps or folders of maps; the repository's test set when absent (with
+    /// --quick: the embedded default map).
+    #[arg(long, value_delimiter = ',')]
+    maps: Vec<PathBuf>,
+    /// This run's share of the maps, I/N (0-based): maps sorted by name, dealt round-robin.
+    #[arg(long, default_value = "0/1")]
+    shard: Shard,
+    /// The GPU adapter: a case-insensitive part of its name, or `cpu`.
+    #[arg(long)]
+    adapter: Option<String>,
+    /// Output folder.
+    #[arg(long, default_value = "target/trade")]
+    out: PathBuf,
+}
+
+#[derive(Subcommand)]
+enum TradeCommand {
+    /// Join shards' outputs (their trade.json) into one run: trade.csv, trade.json, report.html.
+    Merge {
+        /// The shards' output folders.
+        #[arg(required = true)]
+        dirs: Vec<PathBuf>,
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+    },
+}
+
+/// A map's name and how to load it (`None`: the embedded default map).
+type MapSource = (String, Option<PathBuf>);
+
+fn map_list(paths: &[PathBuf], quick: bool) -> Result<Vec<MapSource>, String> {
+    if paths.is_empty() {
+        if quick {
+            return Ok(vec![(envmap_sphere::DEFAULT_MAP_NAME.to_string(), None)]);
+        }
+        let maps = envmap_sphere::test_set::maps().map_err(|e| e.to_string())?;
+        return Ok(maps.into_iter().map(|p| (file_name(&p), Some(p))).collect());
+    }
+    let mut out = Vec::new();
+    for p in paths {
+        if p.is_dir() {
+            let maps = envmap_sphere::test_set::maps_in(p).map_err(|e| e.to_string())?;
+            out.extend(maps.into_iter().map(|m| (file_name(&m), Some(m))));
+        } else {
+            out.push((file_name(p), Some(p.clone())));
+        }
+    }
+    Ok(out)
+}
+
+fn file_name(p: &Path) -> String {
+    p.file_name().map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into_owned())
+}
+
+fn write_all(run: &Run, out: &Path) -> Result<(), String> {
+    run.write(out).map_err(|e| e.to_string())?;
+    let html = trade::report::html(run, &REPORT_BUDGETS).map_err(|e| e.to_string())?;
+    let p = out.join("report.html");
+    std::fs::write(&p, html).map_err(|e| format!("{}: {e}", p.display()))?;
+    outln!("wrote {} (trade.csv, trade.json, report.html)", out.display());
+    Ok(())
+}
+
+fn print_front(run: &Run) {
+    let all = trade::overall(&run.rows);
+    outln!("Pareto front over all scenes and maps (mean ms, mean RMSE, mean FLIP):");
+    for p in trade::pareto_front(&all) {
+        outln!("  {:<64} {:>9.3} ms  RMSE {:.5}  FLIP {:.4}", p.setting, p.ms, p.rmse, p.flip);
+    }
+    for b in REPORT_BUDGETS {
+        match trade::choose(&all, b) {
+            Ok(p) => outln!("budget: {b} ms -> {} (ms {:.3}, rmse {:.5})", p.setting, p.ms, p.rmse),
+            Err(e) => outln!("budget: {b} ms -> {e}"),
+        }
+    }
+}
+
+/// Runs `trade` or `trade merge`.
+pub fn run(args: &TradeArgs) -> Result<(), String> {
+    if let Some(TradeCommand::Merge { dirs, out }) = &args.merge {
+        let runs = dirs
+            .iter()
+            .map(|d| Run::read(d).map(|r| (d.clone(), r)))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| e.to_string())?;
+        let merged = trade::merge(&runs).map_err(|e| e.to_string())?;
+        outln!("merged {} runs ({} measurements; shards {})", runs.len(), merged.rows.len(), merged.shards.join(", "));
+        print_front(&merged);
+        return write_all(&merged, out);
+    }
+    let (preset, plan) = if args.quick { (Preset::Quick, Plan::QUICK) } else { (Preset::Default, Plan::DEFAULT) };
+    let settings = preset.settings();
+    let scenes: Vec<String> = match (args.scenes.is_empty(), args.quick) {
+        (false, _) => args.scenes.clone(),
+        (true, true) => QUICK_SCENES.iter().map(|s| (*s).to_string()).collect(),
+        (true, false) => SCENES.iter().map(|s| (*s).to_string()).collect(),
+    };
+    let maps = args.shard.select(&map_list(&args.maps, args.quick)?, |m| m.0.clone());
+    let gpu = crate::lavapipe::open_gpu(args.adapter.as_deref())?;
+    outln!("GPU: {}", gpu.describe());
+    outln!(
+        "trade: {} settings x {} scenes x {} maps (shard {}), {}x{}, truth {} spp, median of {} frames",
+        settings.len(),
+        scenes.len(),
+        maps.len(),
+        args.shard,
+        plan.size.0,
+        plan.size.1,
+        plan.truth_spp,
+        plan.repeats
+    );
+    let passes = Passes::new(&gpu).map_err(|e| e.to_string())?;
+    let mut run = Run {
+        config: RunConfig {
+            size: plan.size,
+            truth_spp: plan.truth_spp,
+            repeats: plan.repeats,
+            supersample: plan.supersample,
+            adapter: gpu.describe(),
+            preset: if args.quick { "quick" } else { "default" }.into(),
+        },
+        shards: vec![args.shard.to_string()],
+        rows: Vec::new(),
+    };
+    let start = std::time::Instant::now();
+    for (name, path) in &maps {
+        let map = match path {
+            Some(p) => envmap_sphere::EnvMap::load(p).map_err(|e| e.to_string())?,
+            None => envmap_sphere::default_map(),
+        };
+        for scene in &scenes {
+            outln!("[{:>6.1} s] {scene} under {name}: truth", start.elapsed().as_secs_f64());
+            let case = Case::new(scene, name, map.clone(), &plan).map_err(|e| e.to_string())?;
+            let rows = trade::measure(&gpu, &passes, &case, &settings, &plan, &mut |m| {
+                outln!("    {:<64} {:>9.3} ms  RMSE {:.5}  FLIP {:.4}", m.setting, m.ms, m.rmse, m.flip);
+            })
+            .map_err(|e| e.to_string())?;
+            run.rows.extend(rows);
+        }
+    }
+    run.finish();
+    outln!("measured {} settings in {:.1} s", run.rows.len(), start.elapsed().as_secs_f64());
+    print_front(&run);
+    write_all(&run, &args.out)
+}
