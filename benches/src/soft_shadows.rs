@@ -7,7 +7,7 @@ use glam::Vec3;
 use gpu::{GBufferPass, Gpu, GpuError, LightShape, Receivers, SceneGeometry, ShadowTechnique, Visibility};
 use penumbra_wedge::{WedgePath, WedgeSettings, Wedges};
 use ref_tracer::SceneBvh;
-use ref_tracer::visibility::{AreaLight, area_light_visibility_refined};
+use ref_tracer::visibility::{AreaLight, Weighting, area_light_visibility_refined};
 use shadowmap_paraboloid::{MapTechnique, Pcss, ShadowSettings, Technique};
 
 /// Paper 000's scenes and the validation scene.
@@ -43,15 +43,14 @@ pub fn entries(gpu: &Gpu, scene: &scene::Scene) -> Result<Vec<Entry>, GpuError> 
     let hard = ShadowSettings { resolution: 2048, pcf_radius: 1, ..ShadowSettings::default() };
     let maps = MapTechnique::new(gpu, scene, Technique::Orthographic, hard, 1)?;
     let map = |settings: ShadowSettings, n: u32| Box::new(maps.variant(Technique::Orthographic, settings, n));
+    // the covered fraction, unweighted, as the truth here is (`Weighting::Uniform`): the
+    // techniques are compared on the same measure
+    let wedges = WedgeSettings { cosine_weighted: false, ..WedgeSettings::default() };
     let mut out = vec![
-        Entry { family: "wedges", technique: Box::new(Wedges::new(gpu, scene, WedgeSettings::default())) },
+        Entry { family: "wedges", technique: Box::new(Wedges::new(gpu, scene, wedges)) },
         Entry {
             family: "wedges_compute",
-            technique: Box::new(Wedges::new(
-                gpu,
-                scene,
-                WedgeSettings { path: WedgePath::Compute, ..Default::default() },
-            )),
+            technique: Box::new(Wedges::new(gpu, scene, WedgeSettings { path: WedgePath::Compute, ..wedges })),
         },
         Entry { family: "shadow_maps", technique: map(hard, 1) },
     ];
@@ -124,7 +123,14 @@ impl Frame {
             LightShape::Distant { direction, half_angle } => AreaLight::Cone { direction, half_angle },
             LightShape::Sphere { center, radius } => AreaLight::Sphere { center, radius },
         };
-        area_light_visibility_refined(&bvh, &self.points, area, self.scene.camera.width as usize, 6, 32)
+        area_light_visibility_refined(
+            &bvh,
+            &self.points,
+            area,
+            self.scene.camera.width as usize,
+            (6, 32),
+            Weighting::Uniform,
+        )
     }
 
     /// `technique`'s visibility of `light` and its report.

@@ -7,7 +7,8 @@ const MAX_HALF_ANGLE: f32 = 1.5;
 struct Light {
     // xyz unit direction towards a distant light, or a sphere light's centre
     position_or_direction: vec4<f32>,
-    // x 0 distant, 1 sphere; y half-angle (distant) or radius (sphere)
+    // x 0 distant, 1 sphere; y half-angle (distant) or radius (sphere); z 1: weight the disk by
+    // the receiver's cosine (coverage.wgsl's cosine_slope)
     config: vec4<f32>,
 }
 
@@ -41,4 +42,17 @@ fn light_frame(light: Light, p: vec3<f32>) -> LightFrame {
     f.y = cross(f.z, f.x);
     f.tan_a = tan(alpha);
     return f;
+}
+
+// The cosine weight at a receiver with normal n: a point q of the light's unit disk weighs
+// 1 + k.q (proportional to n.d), returned as (1, k) where the disk lies wholly above the
+// receiver's plane (|k| <= 1); (1, 0, 0), uniform, where it straddles the plane or when the
+// light does not ask for weighting (config.z) (`coverage::cosine_weights`).
+fn cosine_weights(light: Light, n: vec3<f32>, f: LightFrame) -> vec3<f32> {
+    let nz = dot(n, f.z);
+    let c = vec2<f32>(dot(n, f.x), dot(n, f.y)) * f.tan_a;
+    if light.config.z < 0.5 || !(nz > 0.0) || length(c) > nz {
+        return vec3<f32>(1.0, 0.0, 0.0);
+    }
+    return vec3<f32>(1.0, c / nz);
 }

@@ -41,6 +41,8 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     // umbra (`coverage::visibility` says why)
     let w = abs(round(a.r));
     let sum_texel = min(vec2<u32>(pixel), textureDimensions(edge_sum) - vec2<u32>(1u));
+    // cosine-weighted edge terms (light.wgsl's cosine_weights) resolve alike: their weight is 1
+    // at the disk's centre and the disk lies wholly above the plane (disk_above = 1)
     let v = clamp(1.0 - w + a.g + textureLoad(edge_sum, sum_texel, 0).r, 0.0, 1.0);
     let n = textureLoad(g_geometric_normal, pixel, 0).xyz;
     return vec4<f32>(clamp(v / max(disk_above(g.xyz, n), 1e-4), 0.0, 1.0));

@@ -33,12 +33,13 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(workgroup_id) til
     if g.w >= 0.0 {
         let f = light_frame(light, g.xyz);
         let n = textureLoad(g_geometric_normal, pixel, 0).xyz;
+        let weights = cosine_weights(light, n, f);
         let range = tile_ranges[tile.y * tiles.size.z + tile.x];
         for (var i = range.x; i < range.x + range.y; i++) {
             let group = groups[i];
             for (var k = group.x; k < group.x + group.y; k++) {
                 let e = edges[k];
-                sum += oriented_edge_term(g.xyz, n, f, e);
+                sum += oriented_edge_term(g.xyz, n, f, e, weights);
             }
         }
     }

@@ -32,10 +32,11 @@ fn fs(in: VsOut) -> @location(0) vec4<f32> {
         discard;
     }
     let f = light_frame(light, g.xyz);
+    let weights = cosine_weights(light, n, f);
     var sum = 0.0;
     for (var k = in.first; k < in.first + in.count; k++) {
         let e = edges[k];
-        sum += oriented_edge_term(g.xyz, n, f, e);
+        sum += oriented_edge_term(g.xyz, n, f, e, weights);
     }
     return vec4<f32>(0.0, sum, 0.0, 0.0);
 }

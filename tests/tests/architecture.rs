@@ -56,7 +56,7 @@ fn transitive(graph: &HashMap<String, Vec<String>>, root: &str) -> BTreeSet<Stri
     seen
 }
 
-const OURS: [&str; 9] = [
+const OURS: [&str; 10] = [
     "envmap-sphere",
     "real-scene",
     "light-extract",
@@ -66,6 +66,7 @@ const OURS: [&str; 9] = [
     "differential-composite",
     "ref-tracer",
     "input-fuzz",
+    "trade",
 ];
 
 #[test]
@@ -138,4 +139,30 @@ fn the_interactive_compositor_never_path_traces() {
             assert!(!text.contains(traced), "{module} path traces ({traced})");
         }
     }
+}
+
+#[test]
+fn the_trade_meets_techniques_only_through_the_trait() {
+    // `trade` builds each technique from its `Shadow` value in one function and otherwise sees
+    // only `gpu::ShadowTechnique`; nothing of the techniques leaks into the fronts, the
+    // chooser, shards, tables or the report
+    let graph = dependency_graph();
+    let deps = transitive(&graph, "trade");
+    assert!(deps.contains("gpu") && deps.contains("penumbra-wedge"), "trade's graph is incomplete: {deps:?}");
+    assert!(!deps.contains("xtask"), "trade depends on xtask");
+    let dir = workspace_tests::workspace_root().join("crates/trade/src");
+    let mut builders = 0;
+    for entry in std::fs::read_dir(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display())) {
+        let path = entry.expect("dir entry").path();
+        let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let name = path.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
+        let named = ["Wedges::new", "MapTechnique::new"].iter().filter(|t| text.contains(*t)).count();
+        if name == "measure.rs" {
+            builders += named;
+        } else {
+            assert_eq!(named, 0, "{name} builds a technique");
+            assert!(!text.contains("penumbra_wedge"), "{name} names penumbra_wedge");
+        }
+    }
+    assert_eq!(builders, 2, "measure.rs builds wedges and maps in `technique`");
 }

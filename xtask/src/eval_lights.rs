@@ -1,28 +1,132 @@
 //! `cargo xtask eval-lights`: every extraction method against the `env-direct` truth, over maps
 //! x scenes, as paper 001's Table 1: mean RMSE and FLIP per method, their ratio to median cut,
 //! and the mean rank; the `emissive-split/...` rows are its Table 2 ablation (masking and k-means
-//! off). Writes `DIR/eval-lights.csv` (one row per map, scene and method) and
-//! `DIR/eval-lights.md`.
+//! off). Writes `DIR/eval-lights.csv` (one row per map, scene and method), `DIR/eval-lights.md`
+//! and `DIR/eval-lights.json` (what `eval-lights merge` joins: a map library's shards, each run
+//! with `--shard I/N`).
 
 use crate::render::load_map;
+use clap::{Args, Subcommand};
 use light_extract::{EmissiveSplit, LightExtractor};
 use ref_tracer::metrics::{FlipTonemap, flip, rmse};
 use ref_tracer::{AmbientMap, EnvLight, Integrator, LightSet, RenderSettings, SceneBvh, Strategy};
+use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use trade::Shard;
 
-pub struct EvalArgs {
-    pub maps: PathBuf,
-    pub scenes: Vec<String>,
-    pub lights: usize,
-    /// Labels of the methods to run (median cut always runs); empty: all.
-    pub methods: Vec<String>,
-    pub spp: u32,
-    pub lights_spp: u32,
-    pub size: (u32, u32),
-    pub out: PathBuf,
+/// `cargo xtask eval-lights`.
+#[derive(Args)]
+#[command(args_conflicts_with_subcommands = true)]
+pub struct EvalLightsArgs {
+    #[command(subcommand)]
+    merge: Option<EvalCommand>,
+    /// Folder of maps; the repository's test set (assets/envmaps) when absent.
+    #[arg(long)]
+    maps: Option<PathBuf>,
+    /// Comma-separated built-in scenes.
+    #[arg(long, default_value = "spheres_box,glossy_set", value_delimiter = ',')]
+    scenes: Vec<String>,
+    /// Lights per method K.
+    #[arg(long, default_value_t = 32)]
+    lights: usize,
+    /// Comma-separated method labels of the table to run (median cut, the reference of the
+    /// ratios, always runs); every method when absent.
+    #[arg(long, value_delimiter = ',')]
+    methods: Vec<String>,
+    /// Samples per pixel of the env-direct truth (its noise floor is reported).
+    #[arg(long, default_value_t = 1024)]
+    spp: u32,
+    /// Samples per pixel of the lights renders (each traces one shadow ray per light).
+    #[arg(long, default_value_t = 32)]
+    lights_spp: u32,
+    /// Image size WIDTHxHEIGHT.
+    #[arg(long, value_parser = crate::parse_size, default_value = "160x120")]
+    size: (u32, u32),
+    /// This run's share of the maps, I/N (0-based): maps sorted by name, dealt round-robin.
+    #[arg(long, default_value = "0/1")]
+    shard: Shard,
+    /// Output folder.
+    #[arg(long, default_value = "target/eval-lights")]
+    out: PathBuf,
 }
 
+#[derive(Subcommand)]
+enum EvalCommand {
+    /// Join shards' outputs (their eval-lights.json) into one table: the unsharded run's.
+    Merge {
+        /// The shards' output folders.
+        #[arg(required = true)]
+        dirs: Vec<PathBuf>,
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+    },
+}
+
+/// How a run measured: shards must agree on it to merge.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+struct EvalConfig {
+    scenes: Vec<String>,
+    lights: usize,
+    methods: Vec<String>,
+    spp: u32,
+    lights_spp: u32,
+    size: (u32, u32),
+}
+
+/// `eval-lights.json`.
+#[derive(Serialize, Deserialize)]
+struct EvalRun {
+    config: EvalConfig,
+    shards: Vec<String>,
+    rows: Vec<Row>,
+}
+
+/// Runs `eval-lights` or `eval-lights merge`.
+pub fn command(args: &EvalLightsArgs) -> Result<(), String> {
+    if let Some(EvalCommand::Merge { dirs, out }) = &args.merge {
+        return merge(dirs, out);
+    }
+    run(args)
+}
+
+fn merge(dirs: &[PathBuf], out: &Path) -> Result<(), String> {
+    let mut merged: Option<EvalRun> = None;
+    for dir in dirs {
+        let p = dir.join("eval-lights.json");
+        let text = std::fs::read_to_string(&p).map_err(|e| format!("{}: {e}", p.display()))?;
+        let run: EvalRun =
+            serde_json::from_str(&text).map_err(|e| format!("{}: not an eval-lights run: {e}", p.display()))?;
+        let m =
+            merged.get_or_insert_with(|| EvalRun { config: run.config.clone(), shards: Vec::new(), rows: Vec::new() });
+        if run.config != m.config {
+            return Err(format!(
+                "{}: measured differently from {}: {:?} vs {:?}",
+                p.display(),
+                dirs[0].display(),
+                run.config,
+                m.config
+            ));
+        }
+        for s in run.shards {
+            if m.shards.contains(&s) {
+                return Err(format!("{}: shard {s} is already in the merge", p.display()));
+            }
+            m.shards.push(s);
+        }
+        if let Some(r) = run.rows.iter().find(|r| m.rows.iter().any(|o| o.map == r.map)) {
+            return Err(format!("{}: map {} is already in the merge", p.display(), r.map));
+        }
+        m.rows.extend(run.rows);
+    }
+    let mut m = merged.ok_or("nothing to merge: give at least one folder with an eval-lights.json")?;
+    m.shards.sort();
+    outln!("merged {} runs ({} rows; shards {})", dirs.len(), m.rows.len(), m.shards.join(", "));
+    write_tables(m.rows, &m.config, m.shards, out)
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 struct Row {
     map: String,
     scene: String,
@@ -82,11 +186,14 @@ fn methods(k: usize) -> Vec<Method> {
         .collect()
 }
 
-pub fn run(args: &EvalArgs) -> Result<(), String> {
-    let maps = envmap_sphere::test_set::maps_in(&args.maps).map_err(|e| e.to_string())?;
-    if maps.is_empty() {
-        return Err(format!("{}: no .exr or .hdr maps", args.maps.display()));
+fn run(args: &EvalLightsArgs) -> Result<(), String> {
+    let dir = args.maps.clone().unwrap_or_else(envmap_sphere::test_set::dir);
+    let all = envmap_sphere::test_set::maps_in(&dir).map_err(|e| e.to_string())?;
+    if all.is_empty() {
+        return Err(format!("{}: no .exr or .hdr maps", dir.display()));
     }
+    let maps =
+        args.shard.select(&all, |p| p.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned()));
     let methods = chosen_methods(args.lights, &args.methods)?;
     let n_methods = methods.len();
     let bar = indicatif::ProgressBar::new((maps.len() * args.scenes.len() * (2 + n_methods)) as u64);
@@ -185,7 +292,15 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
         }
     }
     bar.finish_and_clear();
-    write_tables(&rows, args)
+    let config = EvalConfig {
+        scenes: args.scenes.clone(),
+        lights: args.lights,
+        methods: methods.iter().map(|(label, _)| label.clone()).collect(),
+        spp: args.spp,
+        lights_spp: args.lights_spp,
+        size: args.size,
+    };
+    write_tables(rows, &config, vec![args.shard.to_string()], &args.out)
 }
 
 /// Mean of `value` per method, the ratio of means to median cut's, and the mean rank.
@@ -222,8 +337,13 @@ fn csv_field(s: &str) -> String {
     if s.contains([',', '"', '\n', '\r']) { format!("\"{}\"", s.replace('"', "\"\"")) } else { s.to_string() }
 }
 
-fn write_tables(rows: &[Row], args: &EvalArgs) -> Result<(), String> {
-    std::fs::create_dir_all(&args.out).map_err(|e| format!("{}: {e}", args.out.display()))?;
+/// Writes the CSV, the Markdown table and the JSON of `rows`, sorted by map (a stable sort:
+/// within a map, the run's scene and method order), so shards merged give the unsharded run's
+/// files.
+fn write_tables(mut rows: Vec<Row>, config: &EvalConfig, shards: Vec<String>, out: &Path) -> Result<(), String> {
+    rows.sort_by(|a, b| a.map.cmp(&b.map));
+    let rows = &rows[..];
+    std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
     let mut csv = String::from("map,scene,method,lights,rmse,converged_rmse,flip,extract_ms\n");
     for r in rows {
         let _ = writeln!(
@@ -252,12 +372,12 @@ fn write_tables(rows: &[Row], args: &EvalArgs) -> Result<(), String> {
          \"converged RMSE\" estimates the RMSE against the converged truth: the truth's noise variance \
          (half the floor's mean square) is taken out of each mean square error.\n",
         rows.iter().map(|r| &r.map).collect::<std::collections::BTreeSet<_>>().len(),
-        args.scenes.join(", "),
-        args.lights,
-        args.size.0,
-        args.size.1,
-        args.spp,
-        args.lights_spp
+        config.scenes.join(", "),
+        config.lights,
+        config.size.0,
+        config.size.1,
+        config.spp,
+        config.lights_spp
     );
     let _ = writeln!(
         md,
@@ -274,11 +394,15 @@ fn write_tables(rows: &[Row], args: &EvalArgs) -> Result<(), String> {
             f / bfl
         );
     }
-    let csv_path = args.out.join("eval-lights.csv");
-    let md_path = args.out.join("eval-lights.md");
+    let csv_path = out.join("eval-lights.csv");
+    let md_path = out.join("eval-lights.md");
+    let json_path = out.join("eval-lights.json");
+    let run = EvalRun { config: config.clone(), shards, rows: rows.to_vec() };
+    let json = serde_json::to_string_pretty(&run).map_err(|e| format!("{}: {e}", json_path.display()))?;
     std::fs::write(&csv_path, csv).map_err(|e| format!("{}: {e}", csv_path.display()))?;
     std::fs::write(&md_path, &md).map_err(|e| format!("{}: {e}", md_path.display()))?;
+    std::fs::write(&json_path, json).map_err(|e| format!("{}: {e}", json_path.display()))?;
     outln!("{md}");
-    outln!("\nwrote {} and {}", csv_path.display(), md_path.display());
+    outln!("\nwrote {}, {} and {}", csv_path.display(), md_path.display(), json_path.display());
     Ok(())
 }

@@ -91,35 +91,10 @@ enum Command {
         #[arg(long, default_value_t = 1.0)]
         lux_per_unit: f32,
     },
-    /// Every extraction method against the env-direct truth over maps x scenes: Markdown and CSV
-    /// tables under target/eval-lights (paper 001's Table 1).
-    EvalLights {
-        /// Folder of maps; the repository's test set (assets/envmaps) when absent.
-        #[arg(long)]
-        maps: Option<PathBuf>,
-        /// Comma-separated built-in scenes.
-        #[arg(long, default_value = "spheres_box,glossy_set", value_delimiter = ',')]
-        scenes: Vec<String>,
-        /// Lights per method K.
-        #[arg(long, default_value_t = 32)]
-        lights: usize,
-        /// Comma-separated method labels of the table to run (median cut, the reference of the
-        /// ratios, always runs); every method when absent.
-        #[arg(long, value_delimiter = ',')]
-        methods: Vec<String>,
-        /// Samples per pixel of the env-direct truth (its noise floor is reported).
-        #[arg(long, default_value_t = 1024)]
-        spp: u32,
-        /// Samples per pixel of the lights renders (each traces one shadow ray per light).
-        #[arg(long, default_value_t = 32)]
-        lights_spp: u32,
-        /// Image size WIDTHxHEIGHT.
-        #[arg(long, value_parser = parse_size, default_value = "160x120")]
-        size: (u32, u32),
-        /// Output folder.
-        #[arg(long, default_value = "target/eval-lights")]
-        out: PathBuf,
-    },
+    /// Every extraction method against the env-direct truth over maps x scenes: Markdown, CSV
+    /// and JSON tables under target/eval-lights (paper 001's Table 1). `--shard I/N` runs a
+    /// share of the maps; `eval-lights merge DIR... --out DIR` joins shards.
+    EvalLights(eval_lights::EvalLightsArgs),
     /// RMSE and FLIP of TEST against REF (two lines).
     Compare {
         /// Reference image (.exr or .hdr).
@@ -247,18 +222,7 @@ fn main() -> ExitCode {
         Command::Scene { name, obj } => scene::run(&name, &obj),
         Command::Render(args) => render::run(&args),
         Command::Compare { reference, test } => render::compare(&reference, &test),
-        Command::EvalLights { maps, scenes, lights, methods, spp, lights_spp, size, out } => {
-            eval_lights::run(&eval_lights::EvalArgs {
-                maps: maps.unwrap_or_else(envmap_sphere::test_set::dir),
-                scenes,
-                lights,
-                methods,
-                spp,
-                lights_spp,
-                size,
-                out,
-            })
-        }
+        Command::EvalLights(args) => eval_lights::command(&args),
         Command::Extract { path, method, lights, out, lux_per_unit } => {
             extract::run(&path, &method, lights, out.as_deref(), lux_per_unit)
         }

@@ -475,3 +475,100 @@ fn composite_json_has_the_interface_keys_and_writes_the_images() {
         assert!(err.trim().lines().count() == 1 && err.contains(want), "{err}");
     }
 }
+
+/// The CSV without its timing column (extraction ms is measured anew in every run).
+fn without_timing(csv: &str) -> Vec<String> {
+    csv.lines().map(|l| l.rsplit_once(',').map_or(l, |(rest, _)| rest).to_string()).collect()
+}
+
+#[test]
+fn eval_lights_shards_merge_into_the_unsharded_run() {
+    let dir = fresh_dir("cli-eval-shards");
+    let maps = dir.join("maps");
+    std::fs::create_dir_all(&maps).expect("maps dir");
+    for (from, to) in [("venice_sunset_1k.hdr", "a.hdr"), ("lebombo_1k.hdr", "b.hdr"), ("studio.exr", "c.exr")] {
+        std::fs::copy(shared(from), maps.join(to)).expect("copy map");
+    }
+    let eval = |extra: &[&str], out: &Path| {
+        let base = [
+            "eval-lights",
+            "--maps",
+            maps.to_str().unwrap_or_default(),
+            "--scenes",
+            "spheres_box",
+            "--lights",
+            "4",
+            "--methods",
+            "importance",
+            "--spp",
+            "2",
+            "--lights-spp",
+            "1",
+            "--size",
+            "8x6",
+        ];
+        let o = xtask(&[&base[..], extra, &["--out", out.to_str().unwrap_or_default()]].concat());
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    let whole = dir.join("whole");
+    eval(&[], &whole);
+    let shards: Vec<PathBuf> = (0..2).map(|i| dir.join(format!("shard{i}"))).collect();
+    for (i, s) in shards.iter().enumerate() {
+        eval(&["--shard", &format!("{i}/2")], s);
+    }
+    let rows = |d: &Path| std::fs::read_to_string(d.join("eval-lights.csv")).expect("csv");
+    // each shard has its own maps: 2 and 1 of 3, 3 rows per map (floor, median cut, importance)
+    assert_eq!(rows(&shards[0]).lines().count(), 1 + 2 * 3);
+    assert_eq!(rows(&shards[1]).lines().count(), 1 + 3);
+    let merged = dir.join("merged");
+    let dirs: Vec<&str> = shards.iter().map(|s| s.to_str().unwrap_or_default()).collect();
+    let o = xtask(&[&["eval-lights", "merge"][..], &dirs, &["--out", merged.to_str().unwrap_or_default()]].concat());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(without_timing(&rows(&merged)), without_timing(&rows(&whole)));
+    // a shard twice, or a folder without a run: exit 1 and say which
+    let again = [dirs[0], dirs[0]];
+    let o = xtask(&[&["eval-lights", "merge"][..], &again, &["--out", merged.to_str().unwrap_or_default()]].concat());
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("already in the merge"));
+    let o = xtask(&["eval-lights", "merge", maps.to_str().unwrap_or_default(), "--out", "x"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("eval-lights.json"));
+}
+
+#[test]
+fn trade_writes_its_three_files_and_merges_them_back() {
+    let dir = fresh_dir("cli-trade");
+    let out = dir.join("run");
+    let o = xtask(&[
+        "trade",
+        "--quick",
+        "--scenes",
+        "three_boxes",
+        "--size",
+        "48x36",
+        "--shard",
+        "0/1",
+        "--out",
+        out.to_str().unwrap_or_default(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.lines().any(|l| l.starts_with("budget: 4 ms -> ")), "{stdout}");
+    let csv = std::fs::read_to_string(out.join("trade.csv")).expect("trade.csv");
+    let header: Vec<&str> = csv.lines().next().unwrap_or_default().split(',').collect();
+    for column in ["setting", "scene", "map", "ms", "rmse", "flip", "pareto"] {
+        assert!(header.contains(&column), "no {column} column: {header:?}");
+    }
+    assert_eq!(csv.lines().count(), 1 + 7, "one row per quick setting: {csv}");
+    assert!(csv.lines().skip(1).any(|l| l.contains(",true,")), "no setting on the front: {csv}");
+    let html = std::fs::read_to_string(out.join("report.html")).expect("report.html");
+    assert_eq!(html.matches("<svg").count(), 2, "a plot over all and one for three_boxes");
+    let merged = dir.join("merged");
+    let o = xtask(&["trade", "merge", out.to_str().unwrap_or_default(), "--out", merged.to_str().unwrap_or_default()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(std::fs::read_to_string(merged.join("trade.csv")).expect("merged csv"), csv);
+    assert!(merged.join("trade.json").is_file() && merged.join("report.html").is_file());
+    let o = xtask(&["trade", "--quick", "--shard", "2/2", "--out", dir.to_str().unwrap_or_default()]);
+    assert_eq!(o.status.code(), Some(2), "clap refuses a bad shard");
+    assert!(String::from_utf8_lossy(&o.stderr).contains("I/N"));
+}

@@ -56,12 +56,15 @@ pub struct WedgeSettings {
     pub edges_per_footprint: u32,
     /// Raster or tiled compute (the hard volume is rasterized either way).
     pub path: WedgePath,
+    /// Weight the light's disk by the receiver's cosine (`coverage` module doc), as a
+    /// Lambertian receiver does; off: the plain covered fraction, paper 000's.
+    pub cosine_weighted: bool,
 }
 
 impl Default for WedgeSettings {
-    /// Culling on, 8 edges per footprint, the raster path.
+    /// Culling on, 8 edges per footprint, the raster path, cosine weighting.
     fn default() -> Self {
-        Self { cull: true, edges_per_footprint: 8, path: WedgePath::Raster }
+        Self { cull: true, edges_per_footprint: 8, path: WedgePath::Raster, cosine_weighted: true }
     }
 }
 
@@ -382,7 +385,11 @@ impl ShadowTechnique for Wedges {
             WedgePath::Raster => "",
             WedgePath::Compute => "_compute",
         };
-        format!("wedges{path}{}", if self.settings.cull { "" } else { "_unculled" })
+        format!(
+            "wedges{path}{}{}",
+            if self.settings.cull { "" } else { "_unculled" },
+            if self.settings.cosine_weighted { "" } else { "_unweighted" }
+        )
     }
 
     fn supports(&self, _light: &LightShape) -> bool {
@@ -423,11 +430,12 @@ impl ShadowTechnique for Wedges {
         let buffer = |label, contents: &[u8], usage| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
         };
+        let cosine = if self.settings.cosine_weighted { 1.0 } else { 0.0 };
         let light_params: [[f32; 4]; 2] = match *light {
             LightShape::Distant { direction, half_angle } => {
-                [direction.normalize_or(Vec3::Y).extend(0.0).to_array(), [0.0, half_angle, 0.0, 0.0]]
+                [direction.normalize_or(Vec3::Y).extend(0.0).to_array(), [0.0, half_angle, cosine, 0.0]]
             }
-            LightShape::Sphere { center, radius } => [center.extend(1.0).to_array(), [1.0, radius, 0.0, 0.0]],
+            LightShape::Sphere { center, radius } => [center.extend(1.0).to_array(), [1.0, radius, cosine, 0.0]],
         };
         let view = ViewUniform { view_proj: view_proj.to_cols_array_2d(), eye: camera.eye.extend(1.0).to_array() };
         let view_buf = buffer("wedge view", bytemuck::bytes_of(&view), wgpu::BufferUsages::UNIFORM);

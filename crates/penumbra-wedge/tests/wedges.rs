@@ -9,7 +9,7 @@ use glam::Vec3;
 use gpu::{GBufferPass, Gpu, LightShape, Receivers, SceneGeometry, ShadowTechnique, Visibility};
 use penumbra_wedge::{WedgePath, WedgeSettings, Wedges, coverage};
 use ref_tracer::SceneBvh;
-use ref_tracer::visibility::{AreaLight, VisibilityLight, area_light_visibility, light_visibility};
+use ref_tracer::visibility::{AreaLight, VisibilityLight, Weighting, area_light_visibility, light_visibility};
 use scene::Scene;
 
 fn scene(name: &str, w: u32, h: u32) -> Scene {
@@ -62,8 +62,13 @@ fn area(light: &LightShape) -> AreaLight {
 }
 
 impl Frame {
+    /// Ray-traced visibility weighted by the cosine, as the wedges weigh by default.
     fn truth(&self, light: &LightShape) -> Vec<Option<f32>> {
-        area_light_visibility(&SceneBvh::new(&self.scene), &self.points, area(light), 32)
+        self.truth_weighted(light, Weighting::Cosine)
+    }
+
+    fn truth_weighted(&self, light: &LightShape, weighting: Weighting) -> Vec<Option<f32>> {
+        area_light_visibility(&SceneBvh::new(&self.scene), &self.points, area(light), 32, weighting)
     }
 
     /// The CPU mirror: the same silhouette, the hard count from a ray to the light's centre per
@@ -90,7 +95,7 @@ impl Frame {
             .iter()
             .zip(counts)
             .map(|(&(p, n), count)| {
-                let v = coverage::visibility(p, n, &sil.edges, &sil.normals, count?, light);
+                let v = coverage::cosine_visibility(p, n, &sil.edges, &sil.normals, count?, light);
                 Some((v / coverage::disk_above(p, n, light).max(1e-4)).clamp(0.0, 1.0))
             })
             .collect()
@@ -302,7 +307,7 @@ fn compute_path_writes_the_raster_paths_visibility() {
         ("camera in a volume", inside, across, 8, true),
     ];
     for (what, s, light, edges_per_footprint, cull) in cases {
-        let settings = |path| WedgeSettings { cull, edges_per_footprint, path };
+        let settings = |path| WedgeSettings { cull, edges_per_footprint, path, cosine_weighted: true };
         let raster = render_with(s.clone(), light, settings(WedgePath::Raster));
         let compute = render_with(s, light, settings(WedgePath::Compute));
         let soft = raster.wedges.iter().filter(|v| **v > 0.02 && **v < 0.98).count();
@@ -317,19 +322,53 @@ fn compute_path_writes_the_raster_paths_visibility() {
 fn horizon_light_is_partly_hidden_by_the_ground() {
     // a light straddling the horizon: the ground's edge hides the part of the disk below it
     // from receivers above the ground (their rays there hit its lit side); once that term's sign
-    // was wrong and the shadows of such a light vanished
+    // was wrong and the shadows of such a light vanished. Unweighted against the covered
+    // fraction: a light straddling the ground's plane is unweighted there anyway
+    // (`coverage::cosine_weights`), and the sign does not depend on the weight
     for (elevation, azimuth, half_angle) in [(0.7f32, 59.0f32, 6.4f32), (3.0, -30.0, 8.0), (-2.0, 120.0, 10.0)] {
         let (e, a) = (elevation.to_radians(), azimuth.to_radians());
         let light = LightShape::Distant {
             direction: Vec3::new(e.cos() * a.sin(), e.sin(), e.cos() * a.cos()),
             half_angle: half_angle.to_radians(),
         };
-        let f = render(scene("spheres_box", 160, 120), light);
-        let truth = f.truth(&light);
+        let settings = WedgeSettings { cosine_weighted: false, ..WedgeSettings::default() };
+        let f = render_with(scene("spheres_box", 160, 120), light, settings);
+        let truth = f.truth_weighted(&light, Weighting::Uniform);
         let (mean, soft_mean, _, soft) = compare(&f.wedges, &truth, 0.05);
         assert!(soft > 1000, "{elevation} deg: {soft} penumbra pixels");
         // measured 0.008 / 0.021, 0.003 / 0.008 and 0.013 / 0.029; 0.060 / 0.102 for the first
         // with the sign unflipped
         assert!(mean < 0.025 && soft_mean < 0.05, "{elevation} deg: mean {mean}, in penumbrae {soft_mean}");
     }
+}
+
+#[test]
+fn cosine_weighting_follows_a_low_light_as_a_lambertian_receiver_sees_it() {
+    // a 6-degree cone 7 degrees over the ground (kiara_1_dawn's lights sit so): the open part
+    // of a cone beside a caster is its low, grazing part, which a Lambertian receiver weighs
+    // least. Against the cosine-weighted truth the weighted wedges are much closer than the
+    // covered fraction, and no further from the truth's own weighting than the plain fraction
+    // is from the plain truth
+    let (e, a) = (7f32.to_radians(), 200f32.to_radians());
+    let light = LightShape::Distant {
+        direction: Vec3::new(e.cos() * a.sin(), e.sin(), e.cos() * a.cos()),
+        half_angle: 6f32.to_radians(),
+    };
+    let weighted = render(scene("spheres_box", 160, 120), light);
+    let plain = render_with(
+        scene("spheres_box", 160, 120),
+        light,
+        WedgeSettings { cosine_weighted: false, ..WedgeSettings::default() },
+    );
+    let (truth, uniform) = (weighted.truth(&light), weighted.truth_weighted(&light, Weighting::Uniform));
+    let (w_mean, w_soft, _, soft) = compare(&weighted.wedges, &truth, 0.05);
+    let (p_mean, p_soft, _, _) = compare(&plain.wedges, &truth, 0.05);
+    let (u_mean, u_soft, _, _) = compare(&plain.wedges, &uniform, 0.05);
+    assert!(soft > 500, "{soft} penumbra pixels");
+    assert!(w_soft < 0.6 * p_soft, "weighted {w_soft} vs plain {p_soft} in penumbrae");
+    assert!(w_mean < p_mean, "weighted {w_mean} vs plain {p_mean}");
+    assert!(
+        w_soft < 1.5 * u_soft && w_mean < 1.5 * u_mean,
+        "weighted {w_mean}/{w_soft} vs plain on its own measure {u_mean}/{u_soft}"
+    );
 }

@@ -61,6 +61,16 @@ pub enum AreaLight {
     },
 }
 
+/// How [`area_light_visibility`] weighs the light's directions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Weighting {
+    /// Uniform in solid angle: the covered fraction of the light.
+    Uniform,
+    /// By the cosine to the normal: the fraction of a Lambertian receiver's irradiance from the
+    /// light that arrives (what shading by `unshadowed irradiance x visibility` needs).
+    Cosine,
+}
+
 /// For each `(position, geometric normal)`, the fraction of `light`'s cone of directions above
 /// the surface (as seen from the point, uniform in solid angle) that reaches it unoccluded,
 /// from `n` × `n` stratified directions (cell centres in (cos θ, φ), so the same points give
@@ -68,9 +78,16 @@ pub enum AreaLight {
 /// G-buffer's, facing the camera): directions below it are the surface's own horizon, which the
 /// shading's cosine already removes, so they count neither way. A light wholly below the
 /// surface gives `None` (nothing to shadow: the shading gives it nothing there); a point inside
-/// a sphere light sees all of it.
+/// a sphere light sees all of it. `weighting` weighs each direction uniformly or by its cosine to
+/// the normal.
 #[must_use]
-pub fn area_light_visibility(bvh: &SceneBvh, points: &[(Vec3, Vec3)], light: AreaLight, n: u32) -> Vec<Option<f32>> {
+pub fn area_light_visibility(
+    bvh: &SceneBvh,
+    points: &[(Vec3, Vec3)],
+    light: AreaLight,
+    n: u32,
+    weighting: Weighting,
+) -> Vec<Option<f32>> {
     let eps = bvh.epsilon();
     let n = n.max(1);
     points
@@ -92,7 +109,7 @@ pub fn area_light_visibility(bvh: &SceneBvh, points: &[(Vec3, Vec3)], light: Are
                 }
             };
             let frame = scene::brdf::Frame::new(axis);
-            let (mut lit, mut above) = (0u32, 0u32);
+            let (mut lit, mut above) = (0f32, 0f32);
             for i in 0..n {
                 for j in 0..n {
                     let cos = 1.0 - (i as f32 + 0.5) / n as f32 * (1.0 - cos_max);
@@ -105,14 +122,21 @@ pub fn area_light_visibility(bvh: &SceneBvh, points: &[(Vec3, Vec3)], light: Are
                         let b = oc.dot(dir);
                         (b - (b * b - oc.length_squared() + r * r).max(0.0).sqrt() - eps).max(0.0)
                     });
-                    if ng.dot(dir) <= 0.0 {
+                    let cos = ng.dot(dir);
+                    if cos <= 0.0 {
                         continue;
                     }
-                    above += 1;
-                    lit += u32::from(!bvh.occluded(p + ng * eps, dir, t_max));
+                    let w = match weighting {
+                        Weighting::Uniform => 1.0,
+                        Weighting::Cosine => cos,
+                    };
+                    above += w;
+                    if !bvh.occluded(p + ng * eps, dir, t_max) {
+                        lit += w;
+                    }
                 }
             }
-            (above > 0).then(|| lit as f32 / above as f32)
+            (above > 0.0).then(|| (lit / above).min(1.0))
         })
         .collect()
 }
@@ -127,10 +151,10 @@ pub fn area_light_visibility_refined(
     points: &[(Vec3, Vec3)],
     light: AreaLight,
     width: usize,
-    coarse: u32,
-    fine: u32,
+    (coarse, fine): (u32, u32),
+    weighting: Weighting,
 ) -> Vec<Option<f32>> {
-    let mut out = area_light_visibility(bvh, points, light, coarse);
+    let mut out = area_light_visibility(bvh, points, light, coarse, weighting);
     let w = width.max(1);
     let h = out.len() / w;
     let refine: Vec<usize> = (0..out.len())
@@ -147,7 +171,7 @@ pub fn area_light_visibility_refined(
         })
         .collect();
     let subset: Vec<(Vec3, Vec3)> = refine.iter().map(|&k| points[k]).collect();
-    for (k, v) in refine.into_iter().zip(area_light_visibility(bvh, &subset, light, fine)) {
+    for (k, v) in refine.into_iter().zip(area_light_visibility(bvh, &subset, light, fine, weighting)) {
         out[k] = v;
     }
     out

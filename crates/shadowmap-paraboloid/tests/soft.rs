@@ -5,7 +5,7 @@
 use glam::Vec3;
 use gpu::{GBufferPass, Gpu, LightShape, Receivers, SceneGeometry, ShadowTechnique, Visibility};
 use ref_tracer::SceneBvh;
-use ref_tracer::visibility::{AreaLight, area_light_visibility};
+use ref_tracer::visibility::{AreaLight, Weighting, area_light_visibility};
 use shadowmap_paraboloid::{MapTechnique, Pcss, ShadowSettings, Technique};
 
 /// (mean |error| over pixels the light reaches, mean over penumbra pixels, penumbra pixels).
@@ -23,7 +23,13 @@ fn errors(name: &str, degrees: f32, make: impl Fn(&Gpu, &scene::Scene) -> MapTec
     let vis = Visibility::new(&gpu, 160, 120, 1).unwrap();
     technique.write_visibility(&gpu, &Receivers::new(&gb, &points), &light, &vis.layer(0)).unwrap();
     let v = vis.read(&gpu, 0).unwrap();
-    let truth = area_light_visibility(&SceneBvh::new(&scene), &points, AreaLight::Cone { direction, half_angle }, 32);
+    let truth = area_light_visibility(
+        &SceneBvh::new(&scene),
+        &points,
+        AreaLight::Cone { direction, half_angle },
+        32,
+        Weighting::Uniform,
+    );
     let (mut sum, mut n, mut psum, mut pn) = (0.0, 0, 0.0, 0);
     for (a, b) in v.iter().zip(&truth) {
         let Some(b) = b else { continue };

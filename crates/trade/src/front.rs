@@ -18,6 +18,11 @@ pub struct Measurement {
     pub ms: f64,
     /// Where `ms` comes from.
     pub clock: String,
+    /// The shadow passes' share of `ms` on the GPU, summed over lights (`shadow_clock` says
+    /// which clock: GPU timestamps where the adapter has them).
+    pub shadow_ms: f64,
+    /// Where `shadow_ms` comes from.
+    pub shadow_clock: String,
     /// Extraction time on the CPU (ms), once per map and method, not per frame.
     pub extract_ms: f64,
     /// RMSE against the `env-direct` truth.
@@ -31,6 +36,9 @@ pub struct Measurement {
     pub shadowed: usize,
     /// Lights without one, and why (e.g. no visible receiver faces them; Weber's law).
     pub skipped: Vec<(String, usize)>,
+    /// Work the techniques left out because it could not matter, summed over lights (e.g.
+    /// wedges of edges whose shadow cannot reach a visible receiver).
+    pub culled: Vec<(String, u64)>,
     /// On the Pareto front of its scene and map (no other setting there is at most as slow and
     /// at most as wrong, and better in one).
     pub pareto: bool,

@@ -158,22 +158,25 @@ pub fn html(run: &Run, budgets: &[f64]) -> Result<String, TradeError> {
         let _ =
             write!(h, "<h2>{} under {}</h2><p>The truth's own noise: RMSE {noise:.5}.</p>", escape(scene), escape(map));
         h.push_str(&plot_svg(&format!("{scene} / {map}"), &points)?);
-        h.push_str("<table><tr><th>setting</th><th>ms</th><th>clock</th><th>RMSE</th><th>FLIP</th><th>shadowed</th><th>skipped</th><th>extraction ms (CPU)</th></tr>");
+        h.push_str("<table><tr><th>setting</th><th>ms</th><th>shadow passes ms</th><th>RMSE</th><th>FLIP</th><th>lights shadowed</th><th>lights skipped</th><th>culled</th><th>extraction ms (CPU)</th></tr>");
         let mut sorted = rows.clone();
         sorted.sort_by(|a, b| a.ms.total_cmp(&b.ms));
         for r in sorted {
             let skipped: Vec<String> = r.skipped.iter().map(|(why, n)| format!("{n}: {why}")).collect();
+            let culled: Vec<String> = r.culled.iter().map(|(what, n)| format!("{n} {what}")).collect();
             let _ = write!(
                 h,
-                "<tr{}><td>{}</td><td class=n>{:.3}</td><td>{}</td><td class=n>{:.5}</td><td class=n>{:.4}</td><td class=n>{}</td><td>{}</td><td class=n>{:.1}</td></tr>",
+                "<tr{}><td>{}</td><td class=n>{:.3}</td><td class=n title=\"{}\">{:.3}</td><td class=n>{:.5}</td><td class=n>{:.4}</td><td class=n>{}</td><td>{}</td><td>{}</td><td class=n>{:.1}</td></tr>",
                 if r.pareto { " class=front" } else { "" },
                 escape(&r.setting),
                 r.ms,
-                escape(&r.clock),
+                escape(&r.shadow_clock),
+                r.shadow_ms,
                 r.rmse,
                 r.flip,
                 r.shadowed,
                 escape(&skipped.join("; ")),
+                escape(&culled.join("; ")),
                 r.extract_ms
             );
         }

@@ -47,18 +47,21 @@ impl Run {
     #[must_use]
     pub fn csv(&self) -> String {
         let mut s = String::from(
-            "setting,scene,map,ms,clock,extract_ms,rmse,flip,truth_noise,pareto,method,lights,shadow,indirect_scale,weber,shadowed,skipped\n",
+            "setting,scene,map,ms,clock,shadow_ms,shadow_clock,extract_ms,rmse,flip,truth_noise,pareto,method,lights,shadow,indirect_scale,weber,shadowed,skipped,culled\n",
         );
         for r in &self.rows {
             let skipped: Vec<String> = r.skipped.iter().map(|(why, n)| format!("{n} {why}")).collect();
+            let culled: Vec<String> = r.culled.iter().map(|(what, n)| format!("{n} {what}")).collect();
             let _ = writeln!(
                 s,
-                "{},{},{},{:.4},{},{:.3},{:.6},{:.6},{:.6},{},{},{},{},{},{},{},{}",
+                "{},{},{},{:.4},{},{:.4},{},{:.3},{:.6},{:.6},{:.6},{},{},{},{},{},{},{},{},{}",
                 csv_field(&r.setting),
                 csv_field(&r.scene),
                 csv_field(&r.map),
                 r.ms,
                 csv_field(&r.clock),
+                r.shadow_ms,
+                csv_field(&r.shadow_clock),
                 r.extract_ms,
                 r.rmse,
                 r.flip,
@@ -71,6 +74,7 @@ impl Run {
                 r.knobs.weber,
                 r.shadowed,
                 csv_field(&skipped.join("; ")),
+                csv_field(&culled.join("; ")),
             );
         }
         s

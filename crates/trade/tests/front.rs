@@ -16,12 +16,15 @@ fn row(shadow: Shadow, k: usize, scene: &str, map: &str, ms: f64, rmse: f64) -> 
         map: map.into(),
         ms,
         clock: "test".into(),
+        shadow_ms: ms / 2.0,
+        shadow_clock: "test".into(),
         extract_ms: 1.0,
         rmse,
         flip: rmse / 2.0,
         truth_noise: 0.001,
         shadowed: k,
         skipped: vec![("why, with a comma".into(), 1)],
+        culled: vec![("wedges".into(), 3)],
         pareto: false,
     }
 }

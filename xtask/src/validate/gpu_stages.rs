@@ -15,7 +15,7 @@ use gpu::{
 use light_extract::ExtractedLight;
 use penumbra_wedge::{WedgeSettings, Wedges};
 use ref_tracer::SceneBvh;
-use ref_tracer::visibility::{AreaLight, VisibilityLight, area_light_visibility_refined, light_visibility};
+use ref_tracer::visibility::{AreaLight, VisibilityLight, Weighting, area_light_visibility_refined, light_visibility};
 use shadowmap_paraboloid::{
     MapTechnique, Pcss, ShadowLight, ShadowMapper, ShadowSettings, Technique, disagreement, equal_texel_variants,
     shadow_triangles,
@@ -56,7 +56,8 @@ fn traced_visibility(
                 LightShape::Sphere { center, radius } => AreaLight::Sphere { center, radius },
             };
             let width = receivers.gbuffer.size().0 as usize;
-            let v = area_light_visibility_refined(&bvh, receivers.points, area, width, 2, n);
+            // weighted by the cosine, as the shading needs it (`unshadowed irradiance x visibility`)
+            let v = area_light_visibility_refined(&bvh, receivers.points, area, width, (2, n), Weighting::Cosine);
             (*s, v.into_iter().map(|v| v.unwrap_or(1.0)).collect())
         })
         .collect();

@@ -518,17 +518,22 @@ pub fn parse_thresholds(text: &str, name: &str) -> Result<Thresholds, String> {
     Ok(Thresholds { limits, report_only, name: name.to_string() })
 }
 
-/// The chooser over this run's GPU rows (ray-traced visibility is not a frame technique, and a
-/// row without a time, `gpu_unshadowed`, cannot be placed: both are left out): `budget: MS ms -> ROW (ms M, rmse R)`, or an error naming the cheapest row.
-fn budget_line(rows: &[Row], budget: f64) -> Result<String, String> {
-    let points: Vec<trade::Point> = rows
-        .iter()
+/// This run's GPU rows as points of the trade: the row's time (wall time on this adapter, end
+/// to end) and error. Ray-traced visibility is not a frame technique, and a row without a time
+/// (`gpu_unshadowed`) cannot be placed: both are left out.
+fn gpu_points(rows: &[Row]) -> Vec<trade::Point> {
+    rows.iter()
         .filter(|r| r.name.starts_with("gpu_") && r.name != "gpu_traced_visibility" && r.seconds > 0.0)
         .filter_map(|r| {
             Some(trade::Point { setting: r.name.clone(), ms: r.seconds * 1e3, rmse: r.rmse?, flip: r.flip? })
         })
-        .collect();
-    let p = trade::choose(&points, budget).map_err(|e| format!("--budget-ms: {e}"))?;
+        .collect()
+}
+
+/// The chooser over [`gpu_points`]: `budget: MS ms -> ROW (ms M, rmse R)`, or an error naming
+/// the cheapest row.
+fn budget_line(rows: &[Row], budget: f64) -> Result<String, String> {
+    let p = trade::choose(&gpu_points(rows), budget).map_err(|e| format!("--budget-ms: {e}"))?;
     Ok(format!("budget: {budget} ms -> {} (ms {:.1}, rmse {:.4})", p.setting, p.ms, p.rmse))
 }
 

@@ -134,7 +134,13 @@ impl Report<'_> {
                 if r.seconds > 0.0 { format!("{:.2}", r.seconds) } else { "—".into() }
             );
         }
-        s.push_str("</table><p>Images (same tone mapping as FLIP) and relative luminance error against the reference (black 0, red 25 %, yellow 50 %, white ≥ 75 %).</p><div class=\"grid\">");
+        s.push_str("</table>");
+        let points = super::gpu_points(self.rows);
+        if !points.is_empty() {
+            s.push_str("<h3>This run's trade</h3><p>The GPU rows' error against their time (wall time on this adapter, end to end, readbacks included); the Pareto front in red. <code>cargo xtask trade</code> measures every knob this way, per frame; <code>validate --budget-ms MS</code> picks from these rows.</p>");
+            s.push_str(&trade::report::plot_svg("validate: GPU rows", &points).map_err(|e| e.to_string())?);
+        }
+        s.push_str("<p>Images (same tone mapping as FLIP) and relative luminance error against the reference (black 0, red 25 %, yellow 50 %, white ≥ 75 %).</p><div class=\"grid\">");
         let reference = &self.rows[0].image;
         for r in self.rows {
             let bytes: Vec<u8> = r.image.iter().flat_map(|p| tonemap.apply(*p)).collect();
