@@ -4,6 +4,7 @@
 use crate::TradeError;
 use crate::front::{Point, front, overall};
 use crate::table::Run;
+use plotters::coord::combinators::BindKeyPoints;
 use plotters::prelude::*;
 use std::fmt::Write as _;
 
@@ -36,7 +37,7 @@ pub fn plot_svg(title: &str, points: &[Point]) -> Result<String, TradeError> {
             .margin(12)
             .x_label_area_size(40)
             .y_label_area_size(64)
-            .build_cartesian_2d(xr.log_scale(), yr)
+            .build_cartesian_2d(xr.clone().log_scale().with_key_points(key_points(&xr)), yr)
             .map_err(|e| plot_err(&e))?;
         chart
             .configure_mesh()
@@ -67,11 +68,12 @@ pub fn plot_svg(title: &str, points: &[Point]) -> Result<String, TradeError> {
             .map_err(|e| plot_err(&e))?
             .label("Pareto front")
             .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], RED.stroke_width(2)));
+        // labels alternate above and below their points: neighbours on the front sit close
         chart
-            .draw_series(f.iter().map(|p| {
+            .draw_series(f.iter().enumerate().map(|(k, p)| {
                 EmptyElement::at((p.ms, p.rmse))
                     + Circle::new((0, 0), 5, RED.filled())
-                    + Text::new(label(&p.setting), (6, -14), ("sans-serif", 11))
+                    + Text::new(label(&p.setting), (6, if k % 2 == 0 { -14 } else { 4 }), ("sans-serif", 11))
             }))
             .map_err(|e| plot_err(&e))?;
         chart
@@ -84,6 +86,24 @@ pub fn plot_svg(title: &str, points: &[Point]) -> Result<String, TradeError> {
         root.present().map_err(|e| plot_err(&e))?;
     }
     Ok(svg)
+}
+
+/// Tick values 1, 2, 5 x 10^n within `range` (a log axis over less than a decade otherwise
+/// gets one label).
+fn key_points(range: &std::ops::Range<f64>) -> Vec<f64> {
+    let (lo, hi) = (range.start.max(f64::MIN_POSITIVE), range.end);
+    let mut out = Vec::new();
+    let mut decade = 10f64.powf(lo.log10().floor());
+    while decade <= hi && out.len() < 64 {
+        for m in [1.0, 2.0, 5.0] {
+            let v = decade * m;
+            if v >= lo && v <= hi {
+                out.push(v);
+            }
+        }
+        decade *= 10.0;
+    }
+    out
 }
 
 /// An axis label with about two significant digits: 1200, 35, 4.5, 0.012.
