@@ -42,7 +42,7 @@ pub use supersample::RotatedGrid;
 pub use target::{layer_view, render_target};
 pub use technique::{
     LightShape, PrecomputedVisibility, Receivers, ShadowPassReport, ShadowTechnique, WEBER_FRACTION,
-    WEBER_MAX_RECEIVERS, render_visibility, totals, weber_negligible,
+    WEBER_MAX_RECEIVERS, culled_totals, render_visibility, skip_reasons, totals, weber_negligible,
 };
 pub use timer::Clock;
 pub use upsample::{JointBilateral, UpsamplePass};

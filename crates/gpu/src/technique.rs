@@ -300,6 +300,32 @@ pub fn weber_negligible(
     negligible
 }
 
+/// Why lights got no shadow pass, each reason with its count, in the order first met.
+#[must_use]
+pub fn skip_reasons(reports: &[ShadowPassReport]) -> Vec<(String, usize)> {
+    let mut out: Vec<(String, usize)> = Vec::new();
+    for why in reports.iter().filter_map(|r| r.skipped.as_deref()) {
+        match out.iter_mut().find(|(w, _)| w == why) {
+            Some((_, n)) => *n += 1,
+            None => out.push((why.to_string(), 1)),
+        }
+    }
+    out
+}
+
+/// The work the reports left out ([`ShadowPassReport::culled`]), summed per kind.
+#[must_use]
+pub fn culled_totals(reports: &[ShadowPassReport]) -> Vec<(&'static str, u64)> {
+    let mut out: Vec<(&'static str, u64)> = Vec::new();
+    for &(what, n) in reports.iter().flat_map(|r| r.culled.iter()) {
+        match out.iter_mut().find(|(w, _)| *w == what) {
+            Some((_, total)) => *total += n,
+            None => out.push((what, n)),
+        }
+    }
+    out
+}
+
 /// Totals over a frame's reports: (GPU time, lights shadowed, lights skipped, primitives).
 #[must_use]
 pub fn totals(reports: &[ShadowPassReport]) -> (Duration, usize, usize, u64) {
@@ -383,5 +409,28 @@ impl ShadowTechnique for PrecomputedVisibility {
         });
         crate::fullscreen::draw(gpu, &self.pipeline, &bind, target, wgpu::Color::WHITE)?;
         Ok(ShadowPassReport::default())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn skip_reasons_and_culled_work_add_up_per_kind() {
+        let r = |skipped: Option<&str>, culled: Vec<(&'static str, u64)>| ShadowPassReport {
+            skipped: skipped.map(String::from),
+            culled,
+            ..ShadowPassReport::default()
+        };
+        let reports = [
+            r(Some("b"), vec![]),
+            r(None, vec![("wedges", 3), ("casters", 1)]),
+            r(Some("a"), vec![("wedges", 2)]),
+            r(Some("b"), vec![]),
+        ];
+        assert_eq!(skip_reasons(&reports), vec![("b".to_string(), 2), ("a".to_string(), 1)]);
+        assert_eq!(culled_totals(&reports), vec![("wedges", 5), ("casters", 1)]);
+        assert!(skip_reasons(&[]).is_empty() && culled_totals(&[]).is_empty());
     }
 }

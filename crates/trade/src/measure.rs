@@ -112,13 +112,13 @@ pub fn technique(
     scene: &scene::Scene,
     shadow: &Shadow,
 ) -> Result<Option<Box<dyn ShadowTechnique>>, TradeError> {
-    Ok(match (shadow, shadow.map_settings()) {
-        (Shadow::None, _) => None,
-        (Shadow::Wedges, _) => Some(Box::new(Wedges::new(gpu, scene, WedgeSettings::default()))),
-        (_, Some((settings, n))) => {
-            Some(Box::new(MapTechnique::new(gpu, scene, Technique::Orthographic, settings, n)?))
-        }
-        (_, None) => None,
+    if *shadow == Shadow::Wedges {
+        return Ok(Some(Box::new(Wedges::new(gpu, scene, WedgeSettings::default()))));
+    }
+    // every other technique but `None` is a map technique
+    Ok(match shadow.map_settings() {
+        Some((settings, n)) => Some(Box::new(MapTechnique::new(gpu, scene, Technique::Orthographic, settings, n)?)),
+        None => None,
     })
 }
 
@@ -267,20 +267,8 @@ pub fn measure(
         let image = grid.resolve(&gpu::read_hdr(gpu, &image)?);
         let (shadow_time, shadowed, _, _) = gpu::totals(&reports);
         let shadow_clock = reports.iter().find_map(|r| r.clock).map_or("none (no shadow pass)", gpu::Clock::name);
-        let mut culled: Vec<(String, u64)> = Vec::new();
-        for (what, n) in reports.iter().flat_map(|r| r.culled.iter()) {
-            match culled.iter_mut().find(|(w, _)| w == what) {
-                Some((_, total)) => *total += n,
-                None => culled.push(((*what).to_string(), *n)),
-            }
-        }
-        let mut skipped: Vec<(String, usize)> = Vec::new();
-        for why in reports.iter().filter_map(|r| r.skipped.clone()) {
-            match skipped.iter_mut().find(|(w, _)| *w == why) {
-                Some((_, n)) => *n += 1,
-                None => skipped.push((why, 1)),
-            }
-        }
+        let culled = gpu::culled_totals(&reports).into_iter().map(|(w, n)| (w.to_string(), n)).collect();
+        let skipped = gpu::skip_reasons(&reports);
         let m = Measurement {
             setting: setting.name(),
             knobs: setting.clone(),

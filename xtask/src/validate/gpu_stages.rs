@@ -286,14 +286,7 @@ fn interleaved(
 
 /// ", N skipped: why" per reason, or nothing.
 fn skip_summary(reports: &[gpu::ShadowPassReport]) -> String {
-    let mut reasons: Vec<(&str, usize)> = Vec::new();
-    for r in reports.iter().filter_map(|r| r.skipped.as_deref()) {
-        match reasons.iter_mut().find(|(w, _)| *w == r) {
-            Some((_, n)) => *n += 1,
-            None => reasons.push((r, 1)),
-        }
-    }
-    reasons.iter().map(|(why, n)| format!(", {n} skipped: {why}")).collect()
+    gpu::skip_reasons(reports).iter().map(|(why, n)| format!(", {n} skipped: {why}")).collect()
 }
 
 pub(super) type MaskImages = (Vec<f32>, Vec<f32>, Vec<Option<bool>>, (u32, u32));
