@@ -260,7 +260,7 @@ fn moving(
         let at = start + Vec3::new(-1.0 + 2.0 * s, 0.0, 0.0);
         let object = session.object(&args.object, at).map_err(e)?;
         let frame = c.frame(&object, args.passes);
-        let (image, times) = gc.composite(gpu, c, &frame, &object, mode, settings).map_err(|e| e.to_string())?;
+        let (image, times, _) = gc.composite(gpu, c, &frame, &object, mode, settings).map_err(|e| e.to_string())?;
         let truth = session.truth(&object).map_err(e)?;
         let err = code_error(&image, &truth, &c.photo_ldr);
         if args.json {

@@ -32,15 +32,7 @@ pub struct ShaftsArgs<'a> {
 /// An environment-lit scene's map (the embedded one) and its extracted lights as distant
 /// sources; nothing for a scene lit by its own patches.
 pub fn environment(scene: &RealScene) -> Result<(Option<envmap_sphere::EnvMap>, Vec<scene::DistantLight>), String> {
-    if !scene.environment_lit {
-        return Ok((None, Vec::new()));
-    }
-    let map = envmap_sphere::default_map();
-    let d = light_extract::extractor(crate::validate::DEFAULT_METHOD, 32)
-        .ok_or("no default extractor")?
-        .extract(&map)
-        .map_err(|e| e.to_string())?;
-    Ok((Some(map), d.distant_lights()))
+    differential_composite::setup::environment(scene, crate::validate::DEFAULT_METHOD, 32).map_err(|e| e.to_string())
 }
 
 pub fn run(args: &ShaftsArgs) -> Result<(), String> {

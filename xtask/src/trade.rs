@@ -1,21 +1,23 @@
 //! `cargo xtask trade`: every setting of a preset on scenes x maps, timed on the GPU and
-//! compared with the `env-direct` truth (the `trade` crate measures); DIR/trade.csv,
+//! compared with its family's truth (the `trade` crate measures): environment-lit scenes under
+//! each map, scenes with point lights, real scenes composited into; DIR/trade.csv,
 //! DIR/trade.json and DIR/report.html. `trade merge` joins shards' outputs.
 
 use clap::{Args, Subcommand};
 use std::path::{Path, PathBuf};
-use trade::{Case, Passes, Plan, Preset, Run, RunConfig, Shard};
+use trade::{Case, CompositeCase, Family, Passes, Plan, PointCase, Preset, Run, RunConfig, Shard};
 
 /// Budgets (ms per frame) the report's chooser answers: real-GPU frame budgets, and budgets
 /// lavapipe on 2 cores can meet.
 pub const REPORT_BUDGETS: [f64; 6] = [1.0, 4.0, 16.0, 250.0, 1000.0, 4000.0];
 
-/// The default run's scenes: validate's, the glossy one, paper 000's two.
-const SCENES: [&str; 4] = ["spheres_box", "glossy_set", "three_boxes", "column"];
+/// The default run's scenes: validate's, the glossy one, paper 000's two (environment-lit);
+/// paper 004's room (a point light); paper 003's real scenes (composites).
+const SCENES: [&str; 7] = ["spheres_box", "glossy_set", "three_boxes", "column", "room", "ar_room", "ar_ground"];
 /// The default run's test-set maps beside the embedded one.
 const DEFAULT_MAPS: [&str; 2] = ["st_fagans_interior_1k.hdr", "kiara_1_dawn_1k.hdr"];
 /// `--quick`'s scenes.
-const QUICK_SCENES: [&str; 2] = ["spheres_box", "three_boxes"];
+const QUICK_SCENES: [&str; 4] = ["spheres_box", "three_boxes", "room", "ar_ground"];
 
 /// `cargo xtask trade`.
 #[derive(Args)]
@@ -23,12 +25,14 @@ const QUICK_SCENES: [&str; 2] = ["spheres_box", "three_boxes"];
 pub struct TradeArgs {
     #[command(subcommand)]
     merge: Option<TradeCommand>,
-    /// The quick preset (7 settings, 160x120, the default map, spheres_box and three_boxes), for
-    /// CI.
+    /// The quick preset (11 settings, 160x120, the default map, spheres_box, three_boxes, room
+    /// and ar_ground), for CI.
     #[arg(long)]
     quick: bool,
-    /// Comma-separated built-in scenes; spheres_box, glossy_set, three_boxes and column when
-    /// absent (with --quick: spheres_box and three_boxes).
+    /// Comma-separated built-in scenes. A real scene (ar_room, ar_ground) is composited into;
+    /// a scene with point lights (room) is measured by its point lights; any other is lit by
+    /// each map. When absent: spheres_box, glossy_set, three_boxes, column, room, ar_room and
+    /// ar_ground (with --quick: spheres_box, three_boxes, room, ar_ground).
     #[arg(long, value_delimiter = ',')]
     scenes: Vec<String>,
     /// Comma-separated maps or folders of maps (`assets/envmaps` for the whole test set); when
@@ -42,7 +46,8 @@ pub struct TradeArgs {
     /// Frames timed per setting (the median is kept; under 3, an untimed frame goes first).
     #[arg(long)]
     repeats: Option<u32>,
-    /// This run's share of the maps, I/N (0-based): maps sorted by name, dealt round-robin.
+    /// This run's share of the work, I/N (0-based): the maps (each with every environment-lit
+    /// scene) and the point-light and composite scenes, sorted by name, dealt round-robin.
     #[arg(long, default_value = "0/1")]
     shard: Shard,
     /// The GPU adapter: a case-insensitive part of its name, or `cpu`.
@@ -93,6 +98,35 @@ fn map_list(paths: &[PathBuf], quick: bool) -> Result<Vec<MapSource>, String> {
     Ok(out)
 }
 
+/// A share of the work a shard takes whole: a map with every environment-lit scene, or one
+/// point-light or composite scene.
+#[derive(Clone)]
+enum Unit {
+    Map(MapSource),
+    Point(String),
+    Composite(String),
+}
+
+impl Unit {
+    fn key(&self) -> String {
+        match self {
+            Unit::Map((name, _)) => format!("map:{name}"),
+            Unit::Point(s) => format!("point:{s}"),
+            Unit::Composite(s) => format!("composite:{s}"),
+        }
+    }
+}
+
+/// The family a scene is measured in: composites for real scenes, point for scenes with point
+/// lights, env for the rest.
+fn family_of(scene: &str) -> Result<Family, String> {
+    if real_scene::RealScene::builtin(scene).is_ok() {
+        return Ok(Family::Composite);
+    }
+    let s = scene::Scene::builtin(scene).map_err(|e| format!("--scenes: {e}"))?;
+    Ok(if s.point_lights.is_empty() { Family::Env } else { Family::Point })
+}
+
 fn file_name(p: &Path) -> String {
     p.file_name().map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into_owned())
 }
@@ -107,15 +141,24 @@ fn write_all(run: &Run, out: &Path) -> Result<(), String> {
 }
 
 fn print_front(run: &Run) {
-    let all = trade::overall(&run.rows);
-    outln!("Pareto front over all scenes and maps (mean ms, mean RMSE, mean FLIP):");
-    for p in trade::pareto_front(&all) {
-        outln!("  {:<64} {:>9.3} ms  RMSE {:.5}  FLIP {:.4}", p.setting, p.ms, p.rmse, p.flip);
-    }
-    for b in REPORT_BUDGETS {
-        match trade::choose(&all, b) {
-            Ok(p) => outln!("budget: {b} ms -> {} (ms {:.3}, rmse {:.5})", p.setting, p.ms, p.rmse),
-            Err(e) => outln!("budget: {b} ms -> {e}"),
+    for family in Family::ALL {
+        let all = trade::overall(&run.rows, family);
+        if all.is_empty() {
+            continue;
+        }
+        outln!(
+            "{}: Pareto front over its scenes and maps (mean ms, mean {}, mean FLIP):",
+            family.name(),
+            family.error_axis()
+        );
+        for p in trade::pareto_front(&all) {
+            outln!("  {:<64} {:>9.3} ms  RMSE {:.5}  FLIP {:.4}", p.setting, p.ms, p.rmse, p.flip);
+        }
+        for b in REPORT_BUDGETS {
+            match trade::choose(&all, b) {
+                Ok(p) => outln!("budget: {b} ms -> {} (ms {:.3}, rmse {:.5})", p.setting, p.ms, p.rmse),
+                Err(e) => outln!("budget: {b} ms -> {}: {e}", family.name()),
+            }
         }
     }
 }
@@ -146,18 +189,35 @@ pub fn run(args: &TradeArgs) -> Result<(), String> {
         (true, true) => QUICK_SCENES.iter().map(|s| (*s).to_string()).collect(),
         (true, false) => SCENES.iter().map(|s| (*s).to_string()).collect(),
     };
-    let maps = args.shard.select(&map_list(&args.maps, args.quick)?, |m| m.0.clone());
+    let mut env_scenes = Vec::new();
+    let mut units = Vec::new();
+    for s in &scenes {
+        match family_of(s)? {
+            Family::Env => env_scenes.push(s.clone()),
+            Family::Point => units.push(Unit::Point(s.clone())),
+            Family::Composite => units.push(Unit::Composite(s.clone())),
+        }
+    }
+    if !env_scenes.is_empty() {
+        units.extend(map_list(&args.maps, args.quick)?.into_iter().map(Unit::Map));
+    }
+    let units = args.shard.select(&units, Unit::key);
     let gpu = crate::lavapipe::open_gpu(args.adapter.as_deref())?;
     outln!("GPU: {}", gpu.describe());
+    let count = |f: Family| settings.iter().filter(|s| s.family() == f).count();
     outln!(
-        "trade: {} settings x {} scenes x {} maps (shard {}), {}x{}, truth {} spp, median of {} frames",
-        settings.len(),
-        scenes.len(),
-        maps.len(),
+        "trade: {} environment-lit settings x {} scenes x {} maps, {} point-light settings, {} composite settings (shard {}: {} units), {}x{}, truth {} spp, photographs {} spp, median of {} frames",
+        count(Family::Env),
+        env_scenes.len(),
+        units.iter().filter(|u| matches!(u, Unit::Map(_))).count(),
+        count(Family::Point),
+        count(Family::Composite),
         args.shard,
+        units.len(),
         plan.size.0,
         plan.size.1,
         plan.truth_spp,
+        plan.photo_spp,
         plan.repeats
     );
     let passes = Passes::new(&gpu).map_err(|e| e.to_string())?;
@@ -167,6 +227,7 @@ pub fn run(args: &TradeArgs) -> Result<(), String> {
             truth_spp: plan.truth_spp,
             repeats: plan.repeats,
             supersample: plan.supersample,
+            photo_spp: plan.photo_spp,
             adapter: gpu.describe(),
             preset: if args.quick { "quick" } else { "default" }.into(),
         },
@@ -174,19 +235,34 @@ pub fn run(args: &TradeArgs) -> Result<(), String> {
         rows: Vec::new(),
     };
     let start = std::time::Instant::now();
-    for (name, path) in &maps {
-        let map = match path {
-            Some(p) => envmap_sphere::EnvMap::load(p).map_err(|e| e.to_string())?,
-            None => envmap_sphere::default_map(),
-        };
-        for scene in &scenes {
-            outln!("[{:>6.1} s] {scene} under {name}: truth", start.elapsed().as_secs_f64());
-            let case = Case::new(scene, name, map.clone(), &plan).map_err(|e| e.to_string())?;
-            let rows = trade::measure(&gpu, &passes, &case, &settings, &plan, &mut |m| {
-                outln!("    {:<64} {:>9.3} ms  RMSE {:.5}  FLIP {:.4}", m.setting, m.ms, m.rmse, m.flip);
-            })
-            .map_err(|e| e.to_string())?;
-            run.rows.extend(rows);
+    let mut show = |m: &trade::Measurement| {
+        outln!("    {:<64} {:>9.3} ms  RMSE {:.5}  FLIP {:.4}", m.setting, m.ms, m.rmse, m.flip);
+    };
+    let e = |e: trade::TradeError| e.to_string();
+    for unit in &units {
+        let elapsed = start.elapsed().as_secs_f64();
+        match unit {
+            Unit::Map((name, path)) => {
+                let map = match path {
+                    Some(p) => envmap_sphere::EnvMap::load(p).map_err(|e| e.to_string())?,
+                    None => envmap_sphere::default_map(),
+                };
+                for scene in &env_scenes {
+                    outln!("[{:>6.1} s] {scene} under {name}: truth", start.elapsed().as_secs_f64());
+                    let case = Case::new(scene, name, map.clone(), &plan).map_err(e)?;
+                    run.rows.extend(trade::measure(&gpu, &passes, &case, &settings, &plan, &mut show).map_err(e)?);
+                }
+            }
+            Unit::Point(scene) => {
+                outln!("[{elapsed:>6.1} s] {scene}'s point lights: truth (ray-traced visibility)");
+                let case = PointCase::new(&gpu, &passes, scene, &plan).map_err(e)?;
+                run.rows.extend(trade::measure_point(&gpu, &passes, &case, &settings, &plan, &mut show).map_err(e)?);
+            }
+            Unit::Composite(scene) => {
+                outln!("[{elapsed:>6.1} s] a sphere composited into {scene}: capture, hierarchy, truth");
+                let case = CompositeCase::new(&gpu, scene, trade::BEST_METHOD, &plan).map_err(e)?;
+                run.rows.extend(trade::measure_composite(&gpu, &case, &settings, &plan, &mut show).map_err(e)?);
+            }
         }
     }
     run.finish();

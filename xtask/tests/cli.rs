@@ -543,7 +543,7 @@ fn trade_writes_its_three_files_and_merges_them_back() {
         "trade",
         "--quick",
         "--scenes",
-        "three_boxes",
+        "three_boxes,room,ar_ground",
         "--size",
         "48x36",
         "--shard",
@@ -559,10 +559,19 @@ fn trade_writes_its_three_files_and_merges_them_back() {
     for column in ["setting", "scene", "map", "ms", "rmse", "flip", "pareto"] {
         assert!(header.contains(&column), "no {column} column: {header:?}");
     }
-    assert_eq!(csv.lines().count(), 1 + 7, "one row per quick setting: {csv}");
-    assert!(csv.lines().skip(1).any(|l| l.contains(",true,")), "no setting on the front: {csv}");
+    assert_eq!(csv.lines().count(), 1 + 11, "one row per quick setting of each scene's family: {csv}");
+    for family in [",env,three_boxes,", ",point,room,-,", ",composite,ar_ground,"] {
+        assert_eq!(
+            csv.lines().filter(|l| l.contains(family)).count(),
+            if family == ",env,three_boxes," { 7 } else { 2 }
+        );
+        assert!(
+            csv.lines().any(|l| l.contains(family) && l.contains(",true,")),
+            "no {family} setting on its front: {csv}"
+        );
+    }
     let html = std::fs::read_to_string(out.join("report.html")).expect("report.html");
-    assert_eq!(html.matches("<svg").count(), 2, "a plot over all and one for three_boxes");
+    assert_eq!(html.matches("<svg").count(), 6, "per family a plot over all and one for its scene");
     let merged = dir.join("merged");
     let o = xtask(&["trade", "merge", out.to_str().unwrap_or_default(), "--out", merged.to_str().unwrap_or_default()]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));

@@ -16,7 +16,7 @@ use shadowmap_paraboloid::{ShadowLight, ShadowMapper, ShadowSettings, Technique}
 use shaft_hierarchy::preprocess::{Origin, Source};
 use wgpu::util::DeviceExt;
 
-use crate::compositor::{Compositor, Frame};
+use crate::compositor::{Compositor, Frame, RepTransfer};
 use crate::{Mode, SyntheticObject};
 
 /// Knobs of the GPU compositor.
@@ -36,6 +36,35 @@ impl Default for GpuSettings {
     fn default() -> Self {
         Self { map_resolution: 256, shadow_detail: 22, patch_maps: Technique::DualParaboloid }
     }
+}
+
+impl GpuSettings {
+    /// The light and projection of representative `r`'s shadow map: a patch's hemispherical
+    /// paraboloid (or a cube), an omnidirectional paraboloid from a point on a distant source, an
+    /// orthographic map along a direction.
+    #[must_use]
+    pub fn map_light(&self, c: &Compositor, r: &RepTransfer) -> (ShadowLight, Technique) {
+        match (r.origin, c.prepared.sources[r.origin_source as usize]) {
+            (Origin::Point(p), Source::Patch(_)) if self.patch_maps == Technique::Cube => {
+                (ShadowLight::omni(p), Technique::Cube)
+            }
+            (Origin::Point(p), Source::Patch(j)) => {
+                let n = c.model.patches[j as usize].normal();
+                (ShadowLight::Point { position: p, hemisphere: Some(n) }, Technique::DualParaboloid)
+            }
+            (Origin::Point(p), Source::Distant(_)) => (ShadowLight::omni(p), Technique::DualParaboloid),
+            (Origin::Direction(d), _) => (ShadowLight::Distant { direction: d }, Technique::Orthographic),
+        }
+    }
+}
+
+/// What a frame's shadow maps cost in views, and what was left out.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MapWork {
+    /// Views rendered: paraboloid hemispheres, cube faces, orthographic maps.
+    pub views: u32,
+    /// Paraboloid hemispheres not rendered: a patch emits into one hemisphere (paper 004).
+    pub hemispheres_skipped: u32,
 }
 
 /// Where a GPU frame's time went (wall clock on the CPU, each stage waited for).
@@ -169,8 +198,8 @@ impl GpuCompositor {
         })
     }
 
-    /// Composites `frame` (made by `c.frame`) for `object` in `mode`: the 8-bit image and where
-    /// the time went (`cpu` is `frame`'s own).
+    /// Composites `frame` (made by `c.frame`) for `object` in `mode`: the 8-bit image, where
+    /// the time went (`cpu` is `frame`'s own) and the shadow maps' views.
     ///
     /// # Errors
     /// GPU failures.
@@ -182,7 +211,7 @@ impl GpuCompositor {
         object: &SyntheticObject,
         mode: Mode,
         settings: &GpuSettings,
-    ) -> Result<(Vec<[u8; 3]>, FrameTimes), GpuError> {
+    ) -> Result<(Vec<[u8; 3]>, FrameTimes, MapWork), GpuError> {
         let (w, h) = self.size;
         let mut times = FrameTimes { cpu: frame.cpu(), ..FrameTimes::default() };
         // the G-buffer of the reconstruction with the object (its index: after the patches)
@@ -231,21 +260,20 @@ impl GpuCompositor {
             .reps
             .iter()
             .map(|r| {
-                let (light, technique) = match (r.origin, c.prepared.sources[r.origin_source as usize]) {
-                    (Origin::Point(p), Source::Patch(_)) if settings.patch_maps == Technique::Cube => {
-                        (ShadowLight::omni(p), Technique::Cube)
-                    }
-                    (Origin::Point(p), Source::Patch(j)) => {
-                        let n = c.model.patches[j as usize].normal();
-                        (ShadowLight::Point { position: p, hemisphere: Some(n) }, Technique::DualParaboloid)
-                    }
-                    (Origin::Point(p), Source::Distant(_)) => (ShadowLight::omni(p), Technique::DualParaboloid),
-                    (Origin::Direction(d), _) => (ShadowLight::Distant { direction: d }, Technique::Orthographic),
-                };
+                let (light, technique) = settings.map_light(c, r);
                 self.mapper.render(gpu, &casters, &light, technique, &map_settings)
             })
             .collect::<Result<Vec<_>, _>>()?;
         times.shadow_maps = t.elapsed();
+        let mut work = MapWork::default();
+        for m in &maps {
+            work.views += m.views.len() as u32;
+            // a hemispherical light's paraboloid map has its front view alone
+            let hemispherical = matches!(m.light, ShadowLight::Point { hemisphere: Some(_), .. });
+            if m.technique == Technique::DualParaboloid && hemispherical {
+                work.hemispheres_skipped += 2 - m.views.len() as u32;
+            }
+        }
         let t = Instant::now();
         let mask_view = self.mask.layer(0);
         let mut encoder = gpu.encoder("composite masks");
@@ -285,7 +313,7 @@ impl GpuCompositor {
         let t = Instant::now();
         let image = self.resolve(gpu, c, &gb, frame, object, mode)?;
         times.resolve = t.elapsed();
-        Ok((image, times))
+        Ok((image, times, work))
     }
 
     fn resolve(

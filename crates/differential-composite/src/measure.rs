@@ -7,7 +7,7 @@ use std::time::Duration;
 use gpu::{Gpu, GpuError};
 
 use crate::compositor::Frame;
-use crate::gpu::{FrameTimes, GpuCompositor, GpuSettings};
+use crate::gpu::{FrameTimes, GpuCompositor, GpuSettings, MapWork};
 use crate::ldr::Dataset;
 use crate::{CodeError, Mode, Session, SyntheticObject, code_error};
 
@@ -26,6 +26,8 @@ pub struct Row {
     pub error: CodeError,
     /// The median frame's times over the repeats.
     pub times: FrameTimes,
+    /// Its shadow maps' views.
+    pub work: MapWork,
     /// The composite.
     pub image: Vec<[u8; 3]>,
 }
@@ -72,14 +74,14 @@ pub fn rows(
     let mut out = Vec::new();
     for &n in passes {
         for &mode in modes {
-            let mut runs: Vec<(Frame, Vec<[u8; 3]>, FrameTimes)> = Vec::new();
+            let mut runs: Vec<(Frame, Vec<[u8; 3]>, FrameTimes, MapWork)> = Vec::new();
             for _ in 0..repeats.max(1) {
                 let frame = c.frame(object, n);
-                let (image, times) = gc.composite(gpu, c, &frame, object, mode, settings)?;
-                runs.push((frame, image, times));
+                let (image, times, work) = gc.composite(gpu, c, &frame, object, mode, settings)?;
+                runs.push((frame, image, times, work));
             }
             runs.sort_by_key(|r| r.2.total());
-            let (frame, image, times) = runs.swap_remove(runs.len() / 2);
+            let (frame, image, times, work) = runs.swap_remove(runs.len() / 2);
             out.push(Row {
                 passes: n,
                 reps: frame.reps.len(),
@@ -87,6 +89,7 @@ pub fn rows(
                 mode,
                 error: code_error(&image, truth, &c.photo_ldr),
                 times,
+                work,
                 image,
             });
         }

@@ -43,6 +43,27 @@ impl Default for SessionSettings {
     }
 }
 
+/// An environment-lit scene's map (the embedded one) and its `k` lights extracted by `method`
+/// as distant sources; nothing for a scene lit by its own patches.
+///
+/// # Errors
+/// An unknown method ([`CompositeError::Parameter`]); an extraction that fails.
+pub fn environment(
+    scene: &RealScene,
+    method: &str,
+    k: usize,
+) -> Result<(Option<EnvMap>, Vec<DistantLight>), CompositeError> {
+    if !scene.environment_lit {
+        return Ok((None, Vec::new()));
+    }
+    let map = envmap_sphere::default_map();
+    let d = light_extract::extractor(method, k)
+        .ok_or_else(|| CompositeError::Parameter(format!("unknown extraction method {method:?}")))?
+        .extract(&map)
+        .map_err(|e| CompositeError::Parameter(format!("extraction ({method}): {e}")))?;
+    Ok((Some(map), d.distant_lights()))
+}
+
 /// The real scene, its photograph and the compositor built from its reconstruction.
 pub struct Session {
     /// The real scene, solved (the truth renders it).

@@ -290,3 +290,32 @@ fn extremes_black_receivers_and_an_object_in_a_shaft_only() {
     let near = near_object(&s.compositor, &object);
     assert!(darkening(&s.compositor, &cpu_composite(s, &frame, &object, Mode::Hdr), &near) > 0.0);
 }
+
+#[test]
+fn hemispherical_sources_render_one_paraboloid_view_and_cubes_six() {
+    // ar_room is lit by its patches: every representative's source emits into a hemisphere
+    let s = room();
+    let c = &s.compositor;
+    let object = sphere(s, Vec3::new(0.0, 0.3, 0.5));
+    let frame = c.frame(&object, 20);
+    let patches = frame
+        .reps
+        .iter()
+        .filter(|r| {
+            matches!(c.prepared.sources[r.origin_source as usize], shaft_hierarchy::preprocess::Source::Patch(_))
+        })
+        .count() as u32;
+    assert!(patches > 0 && patches as usize == frame.reps.len(), "{patches} of {}", frame.reps.len());
+    let (g, gc) = gpu();
+    let run = |patch_maps| {
+        let settings = GpuSettings { patch_maps, ..GpuSettings::default() };
+        gc.composite(g, c, &frame, &object, Mode::Hdr, &settings).unwrap_or_else(|e| panic!("{e}"))
+    };
+    let (paraboloid, _, work) = run(shadowmap_paraboloid::Technique::DualParaboloid);
+    assert_eq!((work.views, work.hemispheres_skipped), (patches, patches));
+    let (cube, _, work) = run(shadowmap_paraboloid::Technique::Cube);
+    assert_eq!((work.views, work.hemispheres_skipped), (6 * patches, 0));
+    // the hemisphere left out holds nothing the source lights: the composites agree
+    let differ = paraboloid.iter().zip(&cube).filter(|(a, b)| (0..3).any(|ch| a[ch].abs_diff(b[ch]) > 2)).count();
+    assert!((differ as f64) < 0.01 * paraboloid.len() as f64, "{differ} pixels differ");
+}

@@ -63,6 +63,24 @@ impl FlipTonemap {
     }
 }
 
+/// Mean LDR-FLIP error of the 8-bit sRGB image `test` against `reference` (both `width` x
+/// `height`), in [0, 1]: for images that are 8-bit already (photographs, composites).
+///
+/// # Panics
+/// When the images differ in size or do not match `width` x `height`.
+#[must_use]
+pub fn flip_rgb8(reference: &[[u8; 3]], test: &[[u8; 3]], width: u32, height: u32) -> f64 {
+    assert_eq!(reference.len(), test.len(), "images differ in size");
+    assert_eq!(reference.len(), (width * height) as usize, "size does not match the pixels");
+    let (a, b): (Vec<u8>, Vec<u8>) = (reference.concat(), test.concat());
+    let error = nv_flip::flip(
+        nv_flip::FlipImageRgb8::with_data(width, height, &a),
+        nv_flip::FlipImageRgb8::with_data(width, height, &b),
+        nv_flip::DEFAULT_PIXELS_PER_DEGREE,
+    );
+    f64::from(nv_flip::FlipPool::from_image(&error).mean())
+}
+
 /// Mean FLIP error of `test` against `reference` (both `width` x `height`), in [0, 1].
 ///
 /// # Panics
@@ -106,5 +124,21 @@ mod tests {
         let (fs, fl) = (flip(&img, &small, w, h, &tm), flip(&img, &large, w, h, &tm));
         assert!(fs > 0.0 && fl > 2.0 * fs && fl < 1.0, "{fs} {fl}");
         assert!(tm.describe().contains("ACES"));
+    }
+
+    #[test]
+    fn flip_rgb8_agrees_with_flip_through_the_same_codes() {
+        // an 8-bit image is what `flip` compares after its tone mapping: the same codes give
+        // the same value, and a black image against a grey one the largest
+        let (w, h) = (32, 24);
+        let img: Vec<Vec3> = (0..w * h).map(|k| Vec3::splat(0.1 + (k % 7) as f32 * 0.1)).collect();
+        let dim: Vec<Vec3> = img.iter().map(|p| *p * 0.7).collect();
+        let tm = FlipTonemap::for_reference(&img);
+        let codes = |i: &[Vec3]| -> Vec<[u8; 3]> { i.iter().map(|p| tm.tonemap.apply(*p)).collect() };
+        let (a, b) = (codes(&img), codes(&dim));
+        assert_eq!(flip_rgb8(&a, &a, w, h), 0.0);
+        assert_eq!(flip_rgb8(&a, &b, w, h), flip(&img, &dim, w, h, &tm));
+        let black = vec![[0u8; 3]; (w * h) as usize];
+        assert!(flip_rgb8(&a, &black, w, h) > flip_rgb8(&a, &b, w, h));
     }
 }

@@ -9,12 +9,14 @@ pub struct Measurement {
     pub setting: String,
     /// The setting itself.
     pub knobs: crate::Setting,
-    /// Built-in scene.
+    /// Built-in scene (a real scene's name for a composite).
     pub scene: String,
-    /// Map file name (the embedded default map's name for it).
+    /// Map file name (the embedded default map's name for it); `-` where no map lights the
+    /// frame (point lights; a real scene lit by its own patches).
     pub map: String,
-    /// Milliseconds per frame: G-buffer, shadows and shading, GPU work waited for (median of
-    /// the repeats); `clock` says which clock.
+    /// Milliseconds per frame: everything the frame waits for (env and point: G-buffer,
+    /// shadows, shading; composite: the CPU traversal too), median of the repeats; `clock` says
+    /// which clock.
     pub ms: f64,
     /// Where `ms` comes from.
     pub clock: String,
@@ -23,25 +25,38 @@ pub struct Measurement {
     pub shadow_ms: f64,
     /// Where `shadow_ms` comes from.
     pub shadow_clock: String,
-    /// Extraction time on the CPU (ms), once per map and method, not per frame.
+    /// Extraction time on the CPU (ms), once per map and method, not per frame (0 where
+    /// nothing is extracted).
     pub extract_ms: f64,
-    /// RMSE against the `env-direct` truth.
+    /// RMSE against the family's truth ([`crate::Family::error_axis`]): linear radiance for env
+    /// and point frames, 8-bit codes over the pixels the object changed for composites.
     pub rmse: f64,
     /// Mean FLIP against the truth.
     pub flip: f64,
     /// The truth's own noise: RMSE between two truths of independent seeds, / sqrt 2 (the RMSE
-    /// of one truth against the converged image). Errors near it are not resolved.
+    /// of one truth against the converged image). Errors near it are not resolved. 0 for a
+    /// truth without noise (point lights: rays to the light from the frame's own points).
     pub truth_noise: f64,
-    /// Lights with a shadow pass.
+    /// Lights (composite: representative sources) with a shadow pass.
     pub shadowed: usize,
-    /// Lights without one, and why (e.g. no visible receiver faces them; Weber's law).
+    /// Lights or sources without one, and why (e.g. no visible receiver faces them; Weber's
+    /// law; the shaft hierarchy found the object occludes none of their light).
     pub skipped: Vec<(String, usize)>,
     /// Work the techniques left out because it could not matter, summed over lights (e.g.
-    /// wedges of edges whose shadow cannot reach a visible receiver).
+    /// wedges of edges whose shadow cannot reach a visible receiver; paraboloid hemispheres
+    /// a source does not light).
     pub culled: Vec<(String, u64)>,
     /// On the Pareto front of its scene and map (no other setting there is at most as slow and
     /// at most as wrong, and better in one).
     pub pareto: bool,
+}
+
+impl Measurement {
+    /// The setting's family.
+    #[must_use]
+    pub fn family(&self) -> crate::Family {
+        self.knobs.family()
+    }
 }
 
 /// A point of a front: a name, ms, RMSE, FLIP.
@@ -83,11 +98,12 @@ pub fn mark_fronts(rows: &mut [Measurement]) {
     }
 }
 
-/// One point per setting over every (scene, map) it was measured on: mean ms, mean RMSE,
-/// mean FLIP. Only settings measured on every (scene, map) of the run are kept, so the means
-/// compare like with like. Sorted by ms.
+/// One point per setting of `family` over every (scene, map) of that family: mean ms, mean
+/// RMSE, mean FLIP. Only settings measured on every (scene, map) of the family are kept, so the
+/// means compare like with like; families have their own truths and never mix. Sorted by ms.
 #[must_use]
-pub fn overall(rows: &[Measurement]) -> Vec<Point> {
+pub fn overall(rows: &[Measurement], family: crate::Family) -> Vec<Point> {
+    let rows: Vec<&Measurement> = rows.iter().filter(|r| r.family() == family).collect();
     let mut cases: Vec<(&str, &str)> = rows.iter().map(|r| (r.scene.as_str(), r.map.as_str())).collect();
     cases.sort_unstable();
     cases.dedup();
@@ -97,7 +113,7 @@ pub fn overall(rows: &[Measurement]) -> Vec<Point> {
     let mut out: Vec<Point> = names
         .into_iter()
         .filter_map(|name| {
-            let mine: Vec<&Measurement> = rows.iter().filter(|r| r.setting == name).collect();
+            let mine: Vec<&Measurement> = rows.iter().filter(|r| r.setting == name).copied().collect();
             let complete = cases.iter().all(|(s, m)| mine.iter().any(|r| r.scene == *s && r.map == *m));
             let n = mine.len() as f64;
             complete.then(|| Point {

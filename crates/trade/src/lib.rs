@@ -1,27 +1,38 @@
 //! The speed/accuracy trade, measured and chosen from.
 //!
-//! Every frame the toolkit can draw is a [`Setting`] (extraction method and K, shadow technique
-//! and its knobs, paper 001's split, Weber skipping). [`measure`] times a setting's GPU frame and
-//! takes its error against the `env-direct` truth; [`Run`] holds the measurements and writes
-//! `trade.csv` / `trade.json`; [`front`] marks Pareto fronts and [`choose`] picks the least error
-//! within a time budget; [`Shard`] splits a map library over machines and [`merge`] joins the
-//! shards' runs; [`report::html`] draws the plots.
+//! Every frame the toolkit can draw is a [`Setting`] of one [`Family`]: an environment-lit frame
+//! (extraction method and K, shadow technique and its knobs, paper 001's split, Weber skipping),
+//! a point-lit one (paraboloid or cube maps, their resolution and PCF), or a composite into a
+//! photograph (passes, HDR or LDR, the sources' maps). [`measure`], [`measure_point`] and
+//! [`measure_composite`] time a setting's frame and take its error against the family's truth;
+//! [`Run`] holds the measurements and writes `trade.csv` / `trade.json`; [`front`] marks Pareto
+//! fronts and [`choose`] picks the least error within a time budget, one family at a time;
+//! [`Shard`] splits a map library over machines and [`merge`] joins the shards' runs;
+//! [`report::html`] draws the plots.
 //!
-//! **Architecture invariant:** techniques are reached only through `gpu::ShadowTechnique` and
-//! extraction only through `light_extract::extractor`: a new technique adds a [`Shadow`] value
-//! and one line in [`measure::technique`], nothing else here changes. Library code: no printing,
-//! progress goes to a callback.
+//! **Architecture invariant:** shadow techniques are reached only through
+//! `gpu::ShadowTechnique`, extraction only through `light_extract::extractor`, compositing only
+//! through `differential_composite`'s GPU compositor and its settings: a new technique adds a
+//! [`Shadow`] value and one line in [`measure::technique`], nothing else here changes. Families
+//! never share a front or a choice (their errors are against different truths). Library code:
+//! no printing, progress goes to a callback.
 
+pub mod composite;
 pub mod front;
 pub mod measure;
+pub mod point;
 pub mod report;
 pub mod setting;
 pub mod shard;
 pub mod table;
 
+pub use composite::{CompositeCase, measure_composite};
 pub use front::{ChooseError, Measurement, Point, choose, front as pareto_front, mark_fronts, overall, pareto};
 pub use measure::{Case, Passes, Plan, measure};
-pub use setting::{BEST_METHOD, Preset, Setting, Shadow};
+pub use point::{PointCase, measure_point};
+pub use setting::{
+    BEST_METHOD, CompositeSetting, EnvSetting, Family, PatchMaps, PointSetting, Preset, Setting, Shadow,
+};
 pub use shard::{Shard, ShardError};
 pub use table::{Run, RunConfig, merge};
 

@@ -1,11 +1,11 @@
-//! Measuring a setting: its frame on the GPU (time) against the `env-direct` truth (error).
-//! Techniques come through `gpu::ShadowTechnique` and extraction through
+//! Measuring an environment-lit setting: its frame on the GPU (time) against the `env-direct`
+//! truth (error). Techniques come through `gpu::ShadowTechnique` and extraction through
 //! `light_extract::extractor`; nothing here knows one technique from another beyond building it
 //! from its [`Shadow`] value.
 
 use crate::TradeError;
 use crate::front::Measurement;
-use crate::setting::{Setting, Shadow};
+use crate::setting::{EnvSetting, Setting, Shadow};
 use envmap_sphere::EnvMap;
 use glam::Vec3;
 use gpu::{
@@ -17,7 +17,7 @@ use light_extract::Decomposition;
 use penumbra_wedge::{WedgeSettings, Wedges};
 use ref_tracer::metrics::{FlipTonemap, flip, rmse};
 use ref_tracer::{EnvLight, Integrator, RenderSettings, SceneBvh, Strategy};
-use shadowmap_paraboloid::{MapTechnique, Technique};
+use shadowmap_paraboloid::MapTechnique;
 use std::collections::HashMap;
 use std::time::{Duration, Instant};
 
@@ -33,15 +33,18 @@ pub struct Plan {
     /// GPU frames on a rotated grid of k² + 1 samples per pixel (`gpu::RotatedGrid`), as
     /// `validate`'s: the ground's far edge aliases otherwise and its error hides the shadows'.
     pub supersample: u32,
+    /// Samples per pixel of a composite's photograph and truth (path traced).
+    pub photo_spp: u32,
 }
 
 impl Plan {
-    /// `--quick`: 160 x 120, 64 spp, one frame timed after an untimed one (its times are for
-    /// CI, not for reading).
-    pub const QUICK: Plan = Plan { size: (160, 120), truth_spp: 64, repeats: 1, supersample: 2 };
-    /// The default run: 160 x 120 (lavapipe on 2 cores; pass a size for real GPUs), 128 spp, one
-    /// frame timed after an untimed one (about 15 minutes on 2 cores; `--repeats` for medians).
-    pub const DEFAULT: Plan = Plan { size: (160, 120), truth_spp: 128, repeats: 1, supersample: 2 };
+    /// `--quick`: 160 x 120, 64 spp (composites: 8), one frame timed after an untimed one (its
+    /// times are for CI, not for reading).
+    pub const QUICK: Plan = Plan { size: (160, 120), truth_spp: 64, repeats: 1, supersample: 2, photo_spp: 8 };
+    /// The default run: 160 x 120 (lavapipe on 2 cores; pass a size for real GPUs), 128 spp
+    /// (composites: 16), one frame timed after an untimed one (about 15 minutes on 2 cores;
+    /// `--repeats` for medians).
+    pub const DEFAULT: Plan = Plan { size: (160, 120), truth_spp: 128, repeats: 1, supersample: 2, photo_spp: 16 };
 }
 
 /// One scene under one map, with its truth.
@@ -88,8 +91,8 @@ impl Case {
 
 /// GPU passes built once and shared by every setting.
 pub struct Passes {
-    gbuffer: GBufferPass,
-    shading: ShadingPass,
+    pub(crate) gbuffer: GBufferPass,
+    pub(crate) shading: ShadingPass,
     upsample: UpsamplePass,
 }
 
@@ -117,7 +120,7 @@ pub fn technique(
     }
     // every other technique but `None` is a map technique
     Ok(match shadow.map_settings() {
-        Some((settings, n)) => Some(Box::new(MapTechnique::new(gpu, scene, Technique::Orthographic, settings, n)?)),
+        Some((projection, settings, n)) => Some(Box::new(MapTechnique::new(gpu, scene, projection, settings, n)?)),
         None => None,
     })
 }
@@ -154,7 +157,7 @@ struct FrameInput<'a> {
 fn frame(
     gpu: &Gpu,
     input: &FrameInput,
-    setting: &Setting,
+    setting: &EnvSetting,
     technique: Option<&dyn ShadowTechnique>,
 ) -> Result<(wgpu::Texture, Vec<ShadowPassReport>), TradeError> {
     let d = input.decomposition;
@@ -210,11 +213,13 @@ fn frame(
     Ok((split.texture, reports))
 }
 
-/// Measures every setting on `case`: `plan.repeats` frames timed (median; under 3 repeats an
-/// untimed warm-up frame first), the last one read back and compared with the truth. `progress` is told each measurement as it is made.
+/// Measures every environment-lit setting of `settings` on `case` (the other families are
+/// left to their own cases): `plan.repeats` frames timed (median; under 3 repeats an untimed
+/// warm-up frame first), the last one read back and compared with the truth. `progress` is
+/// told each measurement as it is made.
 ///
 /// # Errors
-/// An unknown method; GPU failures.
+/// An unknown method; a technique that cannot shadow distant lights; GPU failures.
 pub fn measure(
     gpu: &Gpu,
     passes: &Passes,
@@ -233,7 +238,10 @@ pub fn measure(
     let mut cache = Extractions::new();
     let mut specular_cache: HashMap<(String, usize), Option<SpecularAmbient>> = HashMap::new();
     let mut out = Vec::new();
-    for setting in settings {
+    for (knobs, setting) in settings.iter().filter_map(|s| s.as_env().map(|k| (s, k))) {
+        if setting.shadow.for_point_lights() {
+            return Err(TradeError::Render(format!("{}: point-light maps cannot shadow distant lights", knobs.name())));
+        }
         let (d, extract_ms) = extract(&mut cache, &case.map, &setting.method, setting.lights)?;
         let key = (setting.method.clone(), setting.lights);
         if !specular_cache.contains_key(&key) {
@@ -270,8 +278,8 @@ pub fn measure(
         let culled = gpu::culled_totals(&reports).into_iter().map(|(w, n)| (w.to_string(), n)).collect();
         let skipped = gpu::skip_reasons(&reports);
         let m = Measurement {
-            setting: setting.name(),
-            knobs: setting.clone(),
+            setting: knobs.name(),
+            knobs: knobs.clone(),
             scene: case.scene.name.clone(),
             map: case.map_name.clone(),
             ms: median_ms(&times),
@@ -293,6 +301,6 @@ pub fn measure(
     Ok(out)
 }
 
-fn median_ms(times: &[Duration]) -> f64 {
+pub(crate) fn median_ms(times: &[Duration]) -> f64 {
     times.get(times.len() / 2).map_or(f64::NAN, |t| t.as_secs_f64() * 1e3)
 }

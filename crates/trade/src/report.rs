@@ -3,16 +3,18 @@
 
 use crate::TradeError;
 use crate::front::{Point, front, overall};
+use crate::setting::Family;
 use crate::table::Run;
 use plotters::coord::combinators::BindKeyPoints;
 use plotters::prelude::*;
 use std::fmt::Write as _;
 
-/// An SVG plot of RMSE against ms (log time, linear error) with the front drawn and its points named.
+/// An SVG plot of error (`error_axis` names it) against ms (log time, linear error) with the
+/// front drawn and its points named.
 ///
 /// # Errors
 /// [`TradeError::Plot`] when plotters fails (e.g. no finite point).
-pub fn plot_svg(title: &str, points: &[Point]) -> Result<String, TradeError> {
+pub fn plot_svg(title: &str, points: &[Point], error_axis: &str) -> Result<String, TradeError> {
     let finite: Vec<&Point> =
         points.iter().filter(|p| p.ms > 0.0 && p.rmse > 0.0 && p.ms.is_finite() && p.rmse.is_finite()).collect();
     let plot_err = |e: &dyn std::fmt::Display| TradeError::Plot(format!("{title}: {e}"));
@@ -42,7 +44,7 @@ pub fn plot_svg(title: &str, points: &[Point]) -> Result<String, TradeError> {
         chart
             .configure_mesh()
             .x_desc("ms per frame")
-            .y_desc("RMSE against env-direct")
+            .y_desc(error_axis)
             .x_labels(8)
             .y_labels(8)
             .max_light_lines(2)
@@ -88,22 +90,26 @@ pub fn plot_svg(title: &str, points: &[Point]) -> Result<String, TradeError> {
     Ok(svg)
 }
 
-/// Tick values 1, 2, 5 x 10^n within `range` (a log axis over less than a decade otherwise
-/// gets one label).
+/// Tick values 1, 2, 5 x 10^n within `range`, or every 1..9 x 10^n where that gives fewer than
+/// three (a log axis over less than a decade otherwise gets one label).
 fn key_points(range: &std::ops::Range<f64>) -> Vec<f64> {
-    let (lo, hi) = (range.start.max(f64::MIN_POSITIVE), range.end);
-    let mut out = Vec::new();
-    let mut decade = 10f64.powf(lo.log10().floor());
-    while decade <= hi && out.len() < 64 {
-        for m in [1.0, 2.0, 5.0] {
-            let v = decade * m;
-            if v >= lo && v <= hi {
-                out.push(v);
+    let ticks = |mantissas: &[f64]| {
+        let (lo, hi) = (range.start.max(f64::MIN_POSITIVE), range.end);
+        let mut out = Vec::new();
+        let mut decade = 10f64.powf(lo.log10().floor());
+        while decade <= hi && out.len() < 64 {
+            for m in mantissas {
+                let v = decade * m;
+                if v >= lo && v <= hi {
+                    out.push(v);
+                }
             }
+            decade *= 10.0;
         }
-        decade *= 10.0;
-    }
-    out
+        out
+    };
+    let coarse = ticks(&[1.0, 2.0, 5.0]);
+    if coarse.len() >= 3 { coarse } else { ticks(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]) }
 }
 
 /// An axis label with about two significant digits: 1200, 35, 4.5, 0.012.
@@ -121,7 +127,27 @@ fn escape(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
 }
 
-/// The report of `run`, with the chooser's picks for `budgets` (ms) over all scenes and maps.
+/// What each family's truth is, for the report.
+fn truth_text(family: Family, c: &crate::RunConfig) -> String {
+    match family {
+        Family::Env => format!(
+            "Truth: ref-tracer <code>env-direct</code> at {} spp (its noise is two truths of independent seeds apart, / &radic;2). GPU frames on a rotated grid of {} samples per pixel.",
+            c.truth_spp,
+            c.supersample * c.supersample + 1
+        ),
+        Family::Point => format!(
+            "Truth: the same frame (G-buffer on the rotated grid of {} samples per pixel, shading) with the visibility of every point light ray traced from every G-buffer point: the error is the shadow maps' alone, and the truth has no noise.",
+            c.supersample * c.supersample + 1
+        ),
+        Family::Composite => format!(
+            "A sphere composited into the photograph of a built-in real scene (path traced at {} spp, an exact reconstruction, the shaft hierarchy pruning at 2 %). Truth: the real scene path traced with the sphere (its noise: a second truth of another seed, / &radic;2; the composite starts from the photograph, which shares the first truth's seed, so its error can lie below that). Errors in 8-bit codes over the pixels the sphere changed; FLIP on the 8-bit images. Times include the CPU's traversal and transfers and the 8-bit image's readback.",
+            c.photo_spp
+        ),
+    }
+}
+
+/// The report of `run`, with the chooser's picks for `budgets` (ms) within each family over
+/// all its scenes and maps.
 ///
 /// # Errors
 /// A plot that cannot be drawn.
@@ -132,76 +158,95 @@ pub fn html(run: &Run, budgets: &[f64]) -> Result<String, TradeError> {
     );
     let _ = write!(
         h,
-        "<h1>The trade: time against error</h1><p>{} x {}, truth: ref-tracer <code>env-direct</code> at {} spp; GPU frames on a rotated grid of {} samples per pixel; times are the median of {} frames (G-buffer, shadows, shading; GPU work waited for) on <b>{}</b>. Preset: {}. Shards: {}. Plot labels leave out the method when it is the best one, <code>{}</code>.</p>",
+        "<h1>The trade: time against error</h1><p>{} x {}; times are the median of {} frames (everything the frame waits for) on <b>{}</b>. Preset: {}. Shards: {}. Plot labels leave out the method when it is the best one, <code>{}</code>. Each family has its own truth, so its own fronts and choices.</p><ul>",
         c.size.0,
         c.size.1,
-        c.truth_spp,
-        c.supersample * c.supersample + 1,
         c.repeats,
         escape(&c.adapter),
         escape(&c.preset),
         escape(&run.shards.join(", ")),
         crate::BEST_METHOD
     );
-    let all = overall(&run.rows);
-    if !all.is_empty() {
-        h.push_str("<h2>Over all scenes and maps</h2><p>Mean ms and mean RMSE of each setting measured on every scene and map.</p>");
-        h.push_str(&plot_svg("all scenes and maps", &all)?);
-        h.push_str("<h3>The front</h3><table><tr><th>setting</th><th>ms</th><th>RMSE</th><th>FLIP</th></tr>");
-        for p in front(&all) {
-            let _ = write!(
-                h,
-                "<tr><td>{}</td><td class=n>{:.3}</td><td class=n>{:.5}</td><td class=n>{:.4}</td></tr>",
-                escape(&p.setting),
-                p.ms,
-                p.rmse,
-                p.flip
-            );
-        }
-        h.push_str("</table><h3>The chooser</h3><table><tr><th>budget</th><th>choice</th></tr>");
-        for b in budgets {
-            let cell = match crate::front::choose(&all, *b) {
-                Ok(p) => format!("{} ({:.3} ms, RMSE {:.5})", escape(&p.setting), p.ms, p.rmse),
-                Err(e) => escape(&e.to_string()),
-            };
-            let _ = write!(h, "<tr><td class=n>{b} ms</td><td>{cell}</td></tr>");
-        }
-        h.push_str("</table>");
+    let families: Vec<Family> = Family::ALL.into_iter().filter(|f| run.rows.iter().any(|r| r.family() == *f)).collect();
+    for f in &families {
+        let _ = write!(h, "<li><a href=\"#{}\">{}</a></li>", f.name(), f.title());
     }
-    let mut cases: Vec<(&str, &str)> = run.rows.iter().map(|r| (r.scene.as_str(), r.map.as_str())).collect();
-    cases.dedup();
-    for (scene, map) in cases {
-        let rows: Vec<_> = run.rows.iter().filter(|r| r.scene == scene && r.map == map).collect();
-        let points: Vec<Point> =
-            rows.iter().map(|r| Point { setting: r.setting.clone(), ms: r.ms, rmse: r.rmse, flip: r.flip }).collect();
-        let noise = rows.first().map_or(0.0, |r| r.truth_noise);
-        let _ =
-            write!(h, "<h2>{} under {}</h2><p>The truth's own noise: RMSE {noise:.5}.</p>", escape(scene), escape(map));
-        h.push_str(&plot_svg(&format!("{scene} / {map}"), &points)?);
-        h.push_str("<table><tr><th>setting</th><th>ms</th><th>shadow passes ms</th><th>RMSE</th><th>FLIP</th><th>lights shadowed</th><th>lights skipped</th><th>culled</th><th>extraction ms (CPU)</th></tr>");
-        let mut sorted = rows.clone();
-        sorted.sort_by(|a, b| a.ms.total_cmp(&b.ms));
-        for r in sorted {
-            let skipped: Vec<String> = r.skipped.iter().map(|(why, n)| format!("{n}: {why}")).collect();
-            let culled: Vec<String> = r.culled.iter().map(|(what, n)| format!("{n} {what}")).collect();
-            let _ = write!(
-                h,
-                "<tr{}><td>{}</td><td class=n>{:.3}</td><td class=n title=\"{}\">{:.3}</td><td class=n>{:.5}</td><td class=n>{:.4}</td><td class=n>{}</td><td>{}</td><td>{}</td><td class=n>{:.1}</td></tr>",
-                if r.pareto { " class=front" } else { "" },
-                escape(&r.setting),
-                r.ms,
-                escape(&r.shadow_clock),
-                r.shadow_ms,
-                r.rmse,
-                r.flip,
-                r.shadowed,
-                escape(&skipped.join("; ")),
-                escape(&culled.join("; ")),
-                r.extract_ms
-            );
+    h.push_str("</ul>");
+    for family in families {
+        let _ = write!(h, "<h2 id=\"{}\">{}</h2><p>{}</p>", family.name(), family.title(), truth_text(family, c));
+        let axis = family.error_axis();
+        let all = overall(&run.rows, family);
+        if !all.is_empty() {
+            h.push_str("<h3>Over all its scenes and maps</h3><p>Mean ms and mean error of each setting measured on every scene and map of the family.</p>");
+            h.push_str(&plot_svg(&format!("{}: all scenes and maps", family.name()), &all, axis)?);
+            h.push_str("<h4>The front</h4><table><tr><th>setting</th><th>ms</th><th>RMSE</th><th>FLIP</th></tr>");
+            for p in front(&all) {
+                let _ = write!(
+                    h,
+                    "<tr><td>{}</td><td class=n>{:.3}</td><td class=n>{:.5}</td><td class=n>{:.4}</td></tr>",
+                    escape(&p.setting),
+                    p.ms,
+                    p.rmse,
+                    p.flip
+                );
+            }
+            h.push_str("</table><h4>The chooser</h4><table><tr><th>budget</th><th>choice</th></tr>");
+            for b in budgets {
+                let cell = match crate::front::choose(&all, *b) {
+                    Ok(p) => format!("{} ({:.3} ms, RMSE {:.5})", escape(&p.setting), p.ms, p.rmse),
+                    Err(e) => escape(&e.to_string()),
+                };
+                let _ = write!(h, "<tr><td class=n>{b} ms</td><td>{cell}</td></tr>");
+            }
+            h.push_str("</table>");
         }
-        h.push_str("</table>");
+        let mut cases: Vec<(&str, &str)> =
+            run.rows.iter().filter(|r| r.family() == family).map(|r| (r.scene.as_str(), r.map.as_str())).collect();
+        cases.dedup();
+        for (scene, map) in cases {
+            case_section(&mut h, run, family, scene, map)?;
+        }
     }
     h.push_str("</body></html>\n");
     Ok(h)
+}
+
+/// One scene and map of a family: its plot and table.
+fn case_section(h: &mut String, run: &Run, family: Family, scene: &str, map: &str) -> Result<(), TradeError> {
+    let rows: Vec<_> = run.rows.iter().filter(|r| r.family() == family && r.scene == scene && r.map == map).collect();
+    let points: Vec<Point> =
+        rows.iter().map(|r| Point { setting: r.setting.clone(), ms: r.ms, rmse: r.rmse, flip: r.flip }).collect();
+    let noise = rows.first().map_or(0.0, |r| r.truth_noise);
+    let under = if map == "-" { String::new() } else { format!(" under {}", escape(map)) };
+    let _ = write!(h, "<h3>{}{under}</h3><p>The truth's own noise: RMSE {noise:.5}.</p>", escape(scene));
+    let title = if map == "-" { scene.to_string() } else { format!("{scene} / {map}") };
+    h.push_str(&plot_svg(&title, &points, family.error_axis())?);
+    let passes = if family == Family::Composite { "passes" } else { "lights shadowed" };
+    let _ = write!(
+        h,
+        "<table><tr><th>setting</th><th>ms</th><th>shadow passes ms</th><th>RMSE</th><th>FLIP</th><th>{passes}</th><th>skipped</th><th>culled</th><th>extraction ms (CPU)</th></tr>"
+    );
+    let mut sorted = rows.clone();
+    sorted.sort_by(|a, b| a.ms.total_cmp(&b.ms));
+    for r in sorted {
+        let skipped: Vec<String> = r.skipped.iter().map(|(why, n)| format!("{n}: {why}")).collect();
+        let culled: Vec<String> = r.culled.iter().map(|(what, n)| format!("{n} {what}")).collect();
+        let _ = write!(
+            h,
+            "<tr{}><td>{}</td><td class=n>{:.3}</td><td class=n title=\"{}\">{:.3}</td><td class=n>{:.5}</td><td class=n>{:.4}</td><td class=n>{}</td><td>{}</td><td>{}</td><td class=n>{:.1}</td></tr>",
+            if r.pareto { " class=front" } else { "" },
+            escape(&r.setting),
+            r.ms,
+            escape(&r.shadow_clock),
+            r.shadow_ms,
+            r.rmse,
+            r.flip,
+            r.shadowed,
+            escape(&skipped.join("; ")),
+            escape(&culled.join("; ")),
+            r.extract_ms
+        );
+    }
+    h.push_str("</table>");
+    Ok(())
 }

@@ -3,6 +3,7 @@
 
 use crate::TradeError;
 use crate::front::{Measurement, mark_fronts};
+use crate::setting::Setting;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -18,6 +19,9 @@ pub struct RunConfig {
     pub repeats: u32,
     /// GPU frames on a rotated grid of k² + 1 samples per pixel: k.
     pub supersample: u32,
+    /// Samples per pixel of a composite's photograph and truth.
+    #[serde(default)]
+    pub photo_spp: u32,
     /// The GPU adapter.
     pub adapter: String,
     /// The preset's name, or "custom".
@@ -47,15 +51,39 @@ impl Run {
     #[must_use]
     pub fn csv(&self) -> String {
         let mut s = String::from(
-            "setting,scene,map,ms,clock,shadow_ms,shadow_clock,extract_ms,rmse,flip,truth_noise,pareto,method,lights,shadow,indirect_scale,weber,shadowed,skipped,culled\n",
+            "setting,family,scene,map,ms,clock,shadow_ms,shadow_clock,extract_ms,rmse,flip,truth_noise,pareto,method,lights,shadow,indirect_scale,weber,passes,ldr,shadowed,skipped,culled\n",
         );
         for r in &self.rows {
             let skipped: Vec<String> = r.skipped.iter().map(|(why, n)| format!("{n} {why}")).collect();
             let culled: Vec<String> = r.culled.iter().map(|(what, n)| format!("{n} {what}")).collect();
+            // the knobs a family has; the others' cells stay empty
+            let none = String::new;
+            let (method, lights, shadow, scale, weber, passes, ldr) = match &r.knobs {
+                Setting::Env(e) => (
+                    e.method.clone(),
+                    e.lights.to_string(),
+                    e.shadow.name(),
+                    e.indirect_scale.to_string(),
+                    e.weber.to_string(),
+                    none(),
+                    none(),
+                ),
+                Setting::Point(p) => (none(), none(), p.shadow.name(), none(), none(), none(), none()),
+                Setting::Composite(c) => (
+                    none(),
+                    none(),
+                    c.name().rsplit('/').next().unwrap_or_default().to_string(),
+                    none(),
+                    none(),
+                    if c.passes == 0 { "all".to_string() } else { c.passes.to_string() },
+                    c.ldr.to_string(),
+                ),
+            };
             let _ = writeln!(
                 s,
-                "{},{},{},{:.4},{},{:.4},{},{:.3},{:.6},{:.6},{:.6},{},{},{},{},{},{},{},{},{}",
+                "{},{},{},{},{:.4},{},{:.4},{},{:.3},{:.6},{:.6},{:.6},{},{},{},{},{},{},{},{},{},{},{}",
                 csv_field(&r.setting),
+                r.family().name(),
                 csv_field(&r.scene),
                 csv_field(&r.map),
                 r.ms,
@@ -67,11 +95,13 @@ impl Run {
                 r.flip,
                 r.truth_noise,
                 r.pareto,
-                csv_field(&r.knobs.method),
-                r.knobs.lights,
-                r.knobs.shadow.name(),
-                r.knobs.indirect_scale,
-                r.knobs.weber,
+                csv_field(&method),
+                lights,
+                shadow,
+                scale,
+                weber,
+                passes,
+                ldr,
                 r.shadowed,
                 csv_field(&skipped.join("; ")),
                 csv_field(&culled.join("; ")),

@@ -1,14 +1,21 @@
 //! The trade's pure parts: Pareto fronts, the chooser, shards and their merge, the CSV and the
 //! report, on measurements made up here (the GPU measurement is tested in `measure.rs`).
 
-use trade::{ChooseError, Measurement, Point, Run, RunConfig, Setting, Shadow, Shard, choose, merge, overall, pareto};
+use trade::{
+    ChooseError, CompositeSetting, Family, Measurement, Point, PointSetting, Run, RunConfig, Setting, Shadow, Shard,
+    choose, merge, overall, pareto,
+};
 
 fn point(name: &str, ms: f64, rmse: f64) -> Point {
     Point { setting: name.into(), ms, rmse, flip: rmse / 2.0 }
 }
 
 fn row(shadow: Shadow, k: usize, scene: &str, map: &str, ms: f64, rmse: f64) -> Measurement {
-    let knobs = Setting::new(trade::BEST_METHOD, k, shadow);
+    row_of(Setting::new(trade::BEST_METHOD, k, shadow), scene, map, ms, rmse)
+}
+
+fn row_of(knobs: Setting, scene: &str, map: &str, ms: f64, rmse: f64) -> Measurement {
+    let k = 8;
     Measurement {
         setting: knobs.name(),
         knobs,
@@ -30,7 +37,15 @@ fn row(shadow: Shadow, k: usize, scene: &str, map: &str, ms: f64, rmse: f64) -> 
 }
 
 fn config() -> RunConfig {
-    RunConfig { size: (8, 6), truth_spp: 4, repeats: 1, supersample: 1, adapter: "none".into(), preset: "test".into() }
+    RunConfig {
+        size: (8, 6),
+        truth_spp: 4,
+        repeats: 1,
+        supersample: 1,
+        photo_spp: 2,
+        adapter: "none".into(),
+        preset: "test".into(),
+    }
 }
 
 #[test]
@@ -202,8 +217,8 @@ fn runs_round_trip_through_their_files() {
 #[test]
 fn overall_means_only_settings_measured_everywhere() {
     let (mut run, _) = run_and_shards(1);
-    run.rows.retain(|r| !(r.knobs.shadow == Shadow::None && r.map == "c.hdr"));
-    let all = overall(&run.rows);
+    run.rows.retain(|r| !(r.setting.ends_with("/none") && r.map == "c.hdr"));
+    let all = overall(&run.rows, Family::Env);
     assert_eq!(all.len(), 2, "{all:?}");
     let wedges = all.iter().find(|p| p.setting.ends_with("/wedges")).expect("wedges");
     assert!((wedges.ms - 4.5).abs() < 1e-12 && (wedges.rmse - 0.03).abs() < 1e-12);
@@ -217,7 +232,7 @@ fn the_report_draws_one_plot_per_case_and_one_over_all() {
     assert!(html.contains("Pareto front"));
     assert!(html.contains("K32/wedges"), "front labels");
     assert!(html.contains("no setting fits in 0.1 ms"), "the chooser's answer for 0.1 ms");
-    let e = trade::report::plot_svg("empty", &[point("nan", f64::NAN, 0.1)]).expect_err("nothing to plot");
+    let e = trade::report::plot_svg("empty", &[point("nan", f64::NAN, 0.1)], "RMSE").expect_err("nothing to plot");
     assert!(e.to_string().contains("empty"), "{e}");
 }
 
@@ -230,4 +245,48 @@ fn setting_names_are_distinct_in_every_preset() {
         names.dedup();
         assert_eq!(names.len(), n, "{preset:?}");
     }
+}
+
+#[test]
+fn families_keep_their_own_fronts_choices_and_report_sections() {
+    let (mut run, _) = run_and_shards(1);
+    // point and composite settings cheaper than every environment-lit one, their errors in
+    // other units: none of them may enter the env front or choice
+    let point = |shadow, ms, rmse| row_of(Setting::Point(PointSetting { shadow }), "room", "-", ms, rmse);
+    run.rows.push(point(Shadow::Paraboloid { resolution: 1024, pcf: 0, subdivide: true }, 0.2, 0.001));
+    run.rows.push(point(Shadow::Cube { resolution: 592, pcf: 0 }, 0.3, 0.0012));
+    let composite = |passes, ms, rmse| {
+        row_of(Setting::Composite(CompositeSetting::new(passes, false)), "ar_ground", "city.hdr", ms, rmse)
+    };
+    run.rows.push(composite(1, 0.1, 2.5));
+    run.rows.push(composite(50, 0.4, 1.8));
+    run.finish();
+    let env = overall(&run.rows, Family::Env);
+    assert_eq!(env.len(), 3, "{env:?}");
+    assert_eq!(
+        choose(&env, 0.3),
+        Err(ChooseError::OverBudget { budget: 0.3, cheapest: format!("{}/K8/none", trade::BEST_METHOD), ms: 0.5 })
+    );
+    let points = overall(&run.rows, Family::Point);
+    assert_eq!(trade::pareto_front(&points).len(), 1, "the paraboloid is faster and better: {points:?}");
+    assert_eq!(choose(&points, 1.0).map(|p| p.setting), Ok("point/paraboloid_1024".to_string()));
+    let composites = overall(&run.rows, Family::Composite);
+    assert_eq!(choose(&composites, 0.45).map(|p| p.setting), Ok("composite/50/hdr/paraboloid_256".to_string()));
+    assert!(run.rows.iter().filter(|r| r.scene == "room").any(|r| r.pareto), "fronts are per case");
+    // through the files with their families, one CSV column naming each
+    let dir = std::env::temp_dir().join(format!("trade-families-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    run.write(&dir).expect("written");
+    assert_eq!(Run::read(&dir).expect("read back"), run);
+    let csv = std::fs::read_to_string(dir.join("trade.csv")).expect("csv");
+    let _ = std::fs::remove_dir_all(&dir);
+    let family = csv.lines().next().unwrap_or_default().split(',').position(|c| c == "family").expect("family column");
+    for (name, n) in [("env", 18), ("point", 2), ("composite", 2)] {
+        assert_eq!(csv.lines().filter(|l| l.split(',').nth(family) == Some(name)).count(), n, "{name}");
+    }
+    let html = trade::report::html(&run, &[0.1, 4.0]).expect("report");
+    assert_eq!(html.matches("<h2 id=").count(), 3, "a section per family");
+    // per family one plot over all and one per case: env 1 + 6, point 1 + 1, composite 1 + 1
+    assert_eq!(html.matches("<svg").count(), 11);
+    assert!(html.contains(Family::Composite.error_axis()));
 }

@@ -138,7 +138,10 @@ impl Report<'_> {
         let points = super::gpu_points(self.rows);
         if !points.is_empty() {
             s.push_str("<h3>This run's trade</h3><p>The GPU rows' error against their time (wall time on this adapter, end to end, readbacks included); the Pareto front in red. <code>cargo xtask trade</code> measures every knob this way, per frame; <code>validate --budget-ms MS</code> picks from these rows.</p>");
-            s.push_str(&trade::report::plot_svg("validate: GPU rows", &points).map_err(|e| e.to_string())?);
+            s.push_str(
+                &trade::report::plot_svg("validate: GPU rows", &points, trade::Family::Env.error_axis())
+                    .map_err(|e| e.to_string())?,
+            );
         }
         s.push_str("<p>Images (same tone mapping as FLIP) and relative luminance error against the reference (black 0, red 25 %, yellow 50 %, white ≥ 75 %).</p><div class=\"grid\">");
         let reference = &self.rows[0].image;

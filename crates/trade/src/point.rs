@@ -1,0 +1,148 @@
+//! Measuring a point-light setting: a scene's point lights shadowed by paraboloid or cube maps
+//! (paper 004) on the GPU, against the same frame with ray-traced visibility. The truth shares
+//! the frame's G-buffer and shading, so its error is the shadows' alone, and it has no noise: a
+//! ray from every G-buffer point to every light (`ref_tracer::visibility`).
+
+use crate::TradeError;
+use crate::front::Measurement;
+use crate::measure::{Passes, Plan, median_ms, technique};
+use crate::setting::Setting;
+use glam::Vec3;
+use gpu::{
+    Gpu, LightShape, PrecomputedVisibility, Receivers, RotatedGrid, SceneGeometry, ShadeLight, ShadeParams,
+    ShadowPassReport, ShadowTechnique, Visibility, render_visibility,
+};
+use ref_tracer::SceneBvh;
+use ref_tracer::metrics::{FlipTonemap, flip, rmse};
+use ref_tracer::visibility::{VisibilityLight, light_visibility};
+use std::time::Instant;
+
+/// A built-in scene with point lights, and its truth.
+pub struct PointCase {
+    /// The scene at the plan's size.
+    pub scene: scene::Scene,
+    grid: RotatedGrid,
+    geometry: SceneGeometry,
+    lights: Vec<ShadeLight>,
+    shapes: Vec<LightShape>,
+    truth: Vec<Vec3>,
+    tonemap: FlipTonemap,
+}
+
+impl PointCase {
+    /// The frame of `scene_name`'s point lights with ray-traced visibility, on the plan's
+    /// rotated grid.
+    ///
+    /// # Errors
+    /// An unknown scene or one without point lights; GPU failures.
+    pub fn new(gpu: &Gpu, passes: &Passes, scene_name: &str, plan: &Plan) -> Result<Self, TradeError> {
+        let mut scene = scene::Scene::builtin(scene_name).map_err(|e| TradeError::Scene(e.to_string()))?;
+        if scene.point_lights.is_empty() {
+            return Err(TradeError::Scene(format!("{scene_name} has no point lights")));
+        }
+        (scene.camera.width, scene.camera.height) = plan.size;
+        let grid = RotatedGrid::new(&scene.camera, plan.supersample.max(1));
+        let geometry = SceneGeometry::upload(gpu, &scene)?;
+        let lights: Vec<ShadeLight> = scene.point_lights.iter().map(ShadeLight::from).collect();
+        let shapes: Vec<LightShape> = scene.point_lights.iter().map(LightShape::from).collect();
+        let mut case =
+            Self { scene, grid, geometry, lights, shapes, truth: Vec::new(), tonemap: FlipTonemap::for_reference(&[]) };
+        let gb = passes.gbuffer.render(gpu, &case.geometry, case.grid.camera())?;
+        let points = gb.read_points(gpu)?;
+        let bvh = SceneBvh::new(&case.scene);
+        let layers = case
+            .scene
+            .point_lights
+            .iter()
+            .zip(&case.shapes)
+            .map(|(l, shape)| {
+                let v = light_visibility(&bvh, &points, VisibilityLight::Point(l.position));
+                (*shape, v.into_iter().map(|v| if v == Some(false) { 0.0 } else { 1.0 }).collect())
+            })
+            .collect();
+        let traced = PrecomputedVisibility::new(gpu, "ray_traced", gb.size(), layers)?;
+        let (image, _) = case.frame(gpu, passes, &traced)?;
+        case.truth = case.grid.resolve(&gpu::read_hdr(gpu, &image)?);
+        case.tonemap = FlipTonemap::for_reference(&case.truth);
+        Ok(case)
+    }
+
+    /// The truth image.
+    #[must_use]
+    pub fn truth(&self) -> &[Vec3] {
+        &self.truth
+    }
+
+    /// One frame: G-buffer, the lights' visibility by `technique`, shading.
+    fn frame(
+        &self,
+        gpu: &Gpu,
+        passes: &Passes,
+        technique: &dyn ShadowTechnique,
+    ) -> Result<(wgpu::Texture, Vec<ShadowPassReport>), TradeError> {
+        let gb = passes.gbuffer.render(gpu, &self.geometry, self.grid.camera())?;
+        let (w, h) = gb.size();
+        let vis = Visibility::new(gpu, w, h, self.lights.len() as u32)?;
+        let points = gb.read_points(gpu)?;
+        let receivers = Receivers::new(&gb, &points);
+        let reports = render_visibility(gpu, technique, &receivers, &self.shapes, &[], &vis)?;
+        let params = ShadeParams { lights: &self.lights, ambient: None, background: None, specular_ambient: None };
+        let image = passes.shading.render_texture(gpu, &self.geometry, &gb, &params, &vis)?;
+        Ok((image, reports))
+    }
+}
+
+/// Measures every point-light setting of `settings` on `case` as [`crate::measure`] does the
+/// environment-lit ones.
+///
+/// # Errors
+/// A technique that cannot shadow point lights; GPU failures.
+pub fn measure_point(
+    gpu: &Gpu,
+    passes: &Passes,
+    case: &PointCase,
+    settings: &[Setting],
+    plan: &Plan,
+    progress: &mut dyn FnMut(&Measurement),
+) -> Result<Vec<Measurement>, TradeError> {
+    let (w, h) = plan.size;
+    let mut out = Vec::new();
+    for (knobs, setting) in settings.iter().filter_map(|s| s.as_point().map(|k| (s, k))) {
+        let technique = technique(gpu, &case.scene, &setting.shadow)?
+            .filter(|_| setting.shadow.for_point_lights())
+            .ok_or_else(|| TradeError::Render(format!("{}: not a point-light technique", knobs.name())))?;
+        let mut last = if plan.repeats < 3 { Some(case.frame(gpu, passes, technique.as_ref())?) } else { None };
+        let mut times = Vec::new();
+        for _ in 0..plan.repeats.max(1) {
+            let t = Instant::now();
+            let f = case.frame(gpu, passes, technique.as_ref())?;
+            times.push(t.elapsed());
+            last = Some(f);
+        }
+        times.sort();
+        let (image, reports) = last.ok_or_else(|| TradeError::Render("no frame".into()))?;
+        let image = case.grid.resolve(&gpu::read_hdr(gpu, &image)?);
+        let (shadow_time, shadowed, _, _) = gpu::totals(&reports);
+        let m = Measurement {
+            setting: knobs.name(),
+            knobs: knobs.clone(),
+            scene: case.scene.name.clone(),
+            map: "-".into(),
+            ms: median_ms(&times),
+            clock: "wall time (frame: submits + waits, the G-buffer's points read back)".into(),
+            shadow_ms: shadow_time.as_secs_f64() * 1e3,
+            shadow_clock: reports.iter().find_map(|r| r.clock).map_or("none (no shadow pass)", gpu::Clock::name).into(),
+            extract_ms: 0.0,
+            rmse: rmse(&case.truth, &image),
+            flip: flip(&case.truth, &image, w, h, &case.tonemap),
+            truth_noise: 0.0,
+            shadowed,
+            skipped: gpu::skip_reasons(&reports),
+            culled: gpu::culled_totals(&reports).into_iter().map(|(w, n)| (w.to_string(), n)).collect(),
+            pareto: false,
+        };
+        progress(&m);
+        out.push(m);
+    }
+    Ok(out)
+}
