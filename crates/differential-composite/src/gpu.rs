@@ -253,17 +253,19 @@ impl GpuCompositor {
             subdivide_angle: None,
             ..ShadowSettings::default()
         };
-        // the maps first (each renders and waits), then every mask and its share of the
-        // darkening in one submission (the passes reuse one mask layer, in order)
+        // every map in one submission, then every mask and its share of the darkening in
+        // another (the passes reuse one mask layer, in order): two waits a frame, not one a map
         let t = Instant::now();
+        let mut encoder = gpu.encoder("composite maps");
         let maps = frame
             .reps
             .iter()
             .map(|r| {
                 let (light, technique) = settings.map_light(c, r);
-                self.mapper.render(gpu, &casters, &light, technique, &map_settings)
+                self.mapper.record(gpu, &mut encoder, &casters, &light, technique, &map_settings)
             })
             .collect::<Result<Vec<_>, _>>()?;
+        gpu.submit_and_wait(encoder)?;
         times.shadow_maps = t.elapsed();
         let mut work = MapWork::default();
         for m in &maps {

@@ -157,6 +157,29 @@ enum Class {
 /// How a view classifies chunks.
 type Classifier = Box<dyn Fn(&Chunk) -> Class>;
 
+/// A map's texture, views and passes, made before its passes are recorded.
+struct Prepared<'a> {
+    map: ShadowMap,
+    layer_views: Vec<wgpu::TextureView>,
+    binds: Vec<wgpu::BindGroup>,
+    /// Each chunk's class per view.
+    classes: Vec<Vec<Class>>,
+    /// Pipelines for chunks inside a view and across its edge.
+    inside: &'a wgpu::RenderPipeline,
+    straddle: &'a wgpu::RenderPipeline,
+}
+
+impl Prepared<'_> {
+    /// The map, with the triangles each view drew.
+    fn finish(self, drawn: Vec<u32>) -> ShadowMap {
+        let mut map = self.map;
+        for (v, n) in map.views.iter_mut().zip(drawn) {
+            v.triangles_drawn = n;
+        }
+        map
+    }
+}
+
 /// Range of z / |d| over a sphere (centre `q` relative to the light, radius `r`) for unit
 /// `axis`: the cosines of the nearest and farthest angles from the axis.
 fn cos_range(q: Vec3, r: f32, axis: Vec3) -> (f32, f32) {
@@ -283,6 +306,43 @@ impl ShadowMapper {
         technique: Technique,
         settings: &ShadowSettings,
     ) -> Result<ShadowMap, GpuError> {
+        let mut p = self.prepare(gpu, geometry, light, technique, settings)?;
+        let mut drawn = Vec::new();
+        let (time, clock) = gpu.measure(|encoder| drawn = self.record_passes(encoder, geometry, &p))?;
+        p.map.time = time;
+        p.map.clock = clock;
+        Ok(p.finish(drawn))
+    }
+
+    /// Records the shadow map of `light` into `encoder` without submitting it, so that many
+    /// maps (and the passes that read them) go to the GPU in one submission. Its `time` is zero:
+    /// the caller times the submission.
+    ///
+    /// # Errors
+    /// As [`ShadowMapper::render`].
+    pub fn record(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        geometry: &ShadowGeometry,
+        light: &ShadowLight,
+        technique: Technique,
+        settings: &ShadowSettings,
+    ) -> Result<ShadowMap, GpuError> {
+        let p = self.prepare(gpu, geometry, light, technique, settings)?;
+        let drawn = self.record_passes(encoder, geometry, &p);
+        Ok(p.finish(drawn))
+    }
+
+    /// Everything a map's passes need, made before recording them.
+    fn prepare(
+        &self,
+        gpu: &Gpu,
+        geometry: &ShadowGeometry,
+        light: &ShadowLight,
+        technique: Technique,
+        settings: &ShadowSettings,
+    ) -> Result<Prepared<'_>, GpuError> {
         let mut settings = *settings;
         if self.paraboloid_clip.is_none() {
             settings.rejection = Rejection::Discard;
@@ -399,32 +459,41 @@ impl ShadowMapper {
         // each chunk classified once per view, before recording
         let classes: Vec<Vec<Class>> =
             views.iter().map(|(_, classify)| geometry.chunks.iter().map(classify).collect()).collect();
-        let mut drawn = vec![0; views.len()];
-        let (time, clock) = gpu.measure(|encoder| {
-            for (k, (class, bind)) in classes.iter().zip(&binds).enumerate() {
-                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("shadow depth"),
-                    color_attachments: &[],
-                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                        view: &layer_views[k],
-                        depth_ops: Some(wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(1.0),
-                            store: wgpu::StoreOp::Store,
-                        }),
-                        stencil_ops: None,
-                    }),
-                    ..Default::default()
-                });
-                pass.set_bind_group(0, bind, &[]);
-                pass.set_pipeline(inside);
-                drawn[k] = geometry.draw(&mut pass, |c| class[c] == Class::Inside);
-                pass.set_pipeline(straddle);
-                drawn[k] += geometry.draw(&mut pass, |c| class[c] == Class::Straddle);
-            }
-        })?;
-        let views =
-            views.into_iter().zip(drawn).map(|((v, _), triangles_drawn)| ShadowView { triangles_drawn, ..v }).collect();
-        Ok(ShadowMap { texture, views, technique, light: *light, frame, settings, time, clock })
+        let views = views.into_iter().map(|(v, _)| v).collect();
+        let map = ShadowMap {
+            texture,
+            views,
+            technique,
+            light: *light,
+            frame,
+            settings,
+            time: std::time::Duration::ZERO,
+            clock: gpu::Clock::WallTime,
+        };
+        Ok(Prepared { map, layer_views, binds, classes, inside, straddle })
+    }
+
+    /// Records a prepared map's depth passes; the triangles drawn per view.
+    fn record_passes(&self, encoder: &mut wgpu::CommandEncoder, geometry: &ShadowGeometry, p: &Prepared) -> Vec<u32> {
+        let mut drawn = vec![0; p.classes.len()];
+        for (k, (class, bind)) in p.classes.iter().zip(&p.binds).enumerate() {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("shadow depth"),
+                color_attachments: &[],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &p.layer_views[k],
+                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                    stencil_ops: None,
+                }),
+                ..Default::default()
+            });
+            pass.set_bind_group(0, bind, &[]);
+            pass.set_pipeline(p.inside);
+            drawn[k] = geometry.draw(&mut pass, |c| class[c] == Class::Inside);
+            pass.set_pipeline(p.straddle);
+            drawn[k] += geometry.draw(&mut pass, |c| class[c] == Class::Straddle);
+        }
+        drawn
     }
 
     /// Writes `map`'s visibility of each G-buffer pixel into `target` (a visibility layer):

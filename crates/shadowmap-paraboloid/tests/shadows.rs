@@ -310,3 +310,36 @@ fn pcf_softens_only_the_shadow_edges() {
     assert!(flipped * 100 < hard.len(), "{flipped} pixels changed side");
     assert!(partial * 10 < hard.len(), "{partial} fractional pixels: more than the edges");
 }
+
+#[test]
+fn maps_recorded_into_one_submission_equal_maps_rendered_one_by_one() {
+    // a frame batches many maps (the compositor's representatives); each must hold exactly the
+    // depths it holds when rendered and waited for alone
+    let s = Setup::new(room(8, 8));
+    let tris = scene_triangles(&s.scene);
+    let geometry = ShadowGeometry::upload(&s.gpu, &tris, ShadowGeometry::CHUNK_TRIANGLES).unwrap();
+    let settings = ShadowSettings { resolution: 64, subdivide_angle: None, ..ShadowSettings::default() };
+    let p = s.scene.point_lights[0].position;
+    let lights = [
+        (ShadowLight::omni(p), Technique::DualParaboloid),
+        (ShadowLight::Point { position: p + Vec3::X, hemisphere: Some(Vec3::NEG_Y) }, Technique::DualParaboloid),
+        (ShadowLight::omni(p - Vec3::X), Technique::Cube),
+        (ShadowLight::Distant { direction: Vec3::new(0.3, 1.0, 0.2) }, Technique::Orthographic),
+    ];
+    let mut encoder = s.gpu.encoder("batch");
+    let batched: Vec<ShadowMap> = lights
+        .iter()
+        .map(|(l, t)| s.mapper.record(&s.gpu, &mut encoder, &geometry, l, *t, &settings).unwrap())
+        .collect();
+    s.gpu.submit_and_wait(encoder).unwrap();
+    for ((l, t), b) in lights.iter().zip(&batched) {
+        let alone = s.mapper.render(&s.gpu, &geometry, l, *t, &settings).unwrap();
+        assert_eq!(b.views.len(), alone.views.len(), "{t:?}");
+        for layer in 0..alone.views.len() as u32 {
+            let (x, y) = (b.read_layer(&s.gpu, layer).unwrap(), alone.read_layer(&s.gpu, layer).unwrap());
+            assert!(x.iter().any(|d| *d < 1.0), "{t:?} layer {layer}: nothing drawn");
+            assert_eq!(x, y, "{t:?} layer {layer}");
+            assert_eq!(b.views[layer as usize].triangles_drawn, alone.views[layer as usize].triangles_drawn);
+        }
+    }
+}
