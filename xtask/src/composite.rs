@@ -103,8 +103,12 @@ pub fn run(args: &CompositeArgs) -> Result<(), String> {
         "cube" => shadowmap_paraboloid::Technique::Cube,
         other => return Err(format!("--patch-maps {other:?}: paraboloid or cube")),
     };
-    let gpu_settings =
-        GpuSettings { map_resolution: args.map_resolution, shadow_detail: args.shadow_detail, patch_maps };
+    let gpu_settings = GpuSettings {
+        map_resolution: args.map_resolution,
+        shadow_detail: args.shadow_detail,
+        patch_maps,
+        layers_per_array: None,
+    };
     let gpu = crate::lavapipe::open_gpu(args.adapter.as_deref())?;
     say(&format!("GPU: {}", gpu.describe()));
     let probe = RealScene::builtin(&args.scene).map_err(|e| e.to_string())?;

@@ -1,18 +1,21 @@
 //! The compositor on the GPU (paper 003, Section 7, on wgpu): per frame the G-buffer of the
 //! reconstruction with the object, then per representative a hard shadow map of the object's
 //! simplified mesh from its origin (one hemispherical paraboloid map for a patch, paper 004;
-//! an orthographic map for a distant light), its mask over the G-buffer, and the mask times
-//! the representative's transfer added into a darkening buffer; last the resolve: the object
-//! shaded by its SH9 irradiance, the rest the photograph less the darkening (HDR: in radiance,
-//! then the camera response; LDR: in codes).
+//! an orthographic map for a distant light), all of them layers of as few texture arrays as the
+//! adapter allows and rendered in one submission; then one pass per array that, per pixel,
+//! adds every representative's transfer where its map says the object blocks it into a
+//! darkening buffer (the paper's blending pass per source, folded into a loop); last the
+//! resolve: the object shaded by its SH9 irradiance, the rest the photograph less the darkening
+//! (HDR: in radiance, then the camera response; LDR: in codes). A frame waits three times
+//! (maps, masks, resolve), not once a representative.
 //!
 //! Shaders: `shaders/differential-composite/`.
 
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
-use gpu::{GBuffer, GBufferPass, Gpu, GpuError, SceneGeometry, ShadowGeometry, Visibility};
-use shadowmap_paraboloid::{ShadowLight, ShadowMapper, ShadowSettings, Technique};
+use gpu::{GBuffer, GBufferPass, Gpu, GpuError, SceneGeometry, ShadowGeometry};
+use shadowmap_paraboloid::{DEPTH_FORMAT, ShadowLight, ShadowMapper, ShadowSettings, Technique};
 use shaft_hierarchy::preprocess::{Origin, Source};
 use wgpu::util::DeviceExt;
 
@@ -29,12 +32,15 @@ pub struct GpuSettings {
     /// A patch source's map: one hemispherical paraboloid (paper 004), or a cube of six faces
     /// (the baseline that does not know the source emits into a hemisphere).
     pub patch_maps: Technique,
+    /// Most layers of one texture array of maps (a frame's maps share as few arrays as this
+    /// allows, one mask dispatch each); `None`: the adapter's limit.
+    pub layers_per_array: Option<u32>,
 }
 
 impl Default for GpuSettings {
     /// The paper's: 256^2 maps, a 484-triangle sphere, hemispherical paraboloid maps.
     fn default() -> Self {
-        Self { map_resolution: 256, shadow_detail: 22, patch_maps: Technique::DualParaboloid }
+        Self { map_resolution: 256, shadow_detail: 22, patch_maps: Technique::DualParaboloid, layers_per_array: None }
     }
 }
 
@@ -56,6 +62,20 @@ impl GpuSettings {
             (Origin::Direction(d), _) => (ShadowLight::Distant { direction: d }, Technique::Orthographic),
         }
     }
+}
+
+/// Consecutive runs of maps of `views` layers each whose layers fit in `max_layers` (at least
+/// one map a run, whatever its size): (first map, layers) per run.
+#[must_use]
+pub fn batches(views: &[u32], max_layers: u32) -> Vec<(usize, u32)> {
+    let mut out: Vec<(usize, u32)> = Vec::new();
+    for (k, &n) in views.iter().enumerate() {
+        match out.last_mut() {
+            Some((_, layers)) if *layers + n <= max_layers => *layers += n,
+            _ => out.push((k, n)),
+        }
+    }
+    out
 }
 
 /// What a frame's shadow maps cost in views, and what was left out.
@@ -100,11 +120,13 @@ struct GpuPixel {
 
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct AccumulateParams {
+struct MaskParams {
     width: u32,
     height: u32,
     slots: u32,
-    rep: u32,
+    reps: u32,
+    first_rep: u32,
+    pad: [u32; 3],
 }
 
 #[repr(C)]
@@ -126,11 +148,10 @@ pub struct GpuCompositor {
     photo_ldr: wgpu::Buffer,
     darkening: wgpu::Buffer,
     out: wgpu::Buffer,
-    accumulate: wgpu::ComputePipeline,
+    masks: wgpu::ComputePipeline,
     resolve: wgpu::ComputePipeline,
     gbuffer: GBufferPass,
     mapper: ShadowMapper,
-    mask: Visibility,
     size: (u32, u32),
 }
 
@@ -154,7 +175,8 @@ impl GpuCompositor {
         let hdr: Vec<[f32; 4]> = c.photo_hdr.iter().map(|v| v.extend(1.0).to_array()).collect();
         let ldr: Vec<u32> = c.photo_ldr.iter().map(|p| pack(*p)).collect();
         let n = u64::from(w) * u64::from(h);
-        let module = |label: &str, src: &str| gpu::shader::module(&gpu.device, label, src, &[]);
+        let module =
+            |label: &str, src: &str| gpu::shader::module(&gpu.device, label, src, shadowmap_paraboloid::LIBRARY);
         let pipeline = |label: &str, m: &wgpu::ShaderModule| {
             gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(label),
@@ -165,9 +187,9 @@ impl GpuCompositor {
                 cache: None,
             })
         };
-        let accumulate = pipeline(
-            "composite accumulate",
-            &module("composite accumulate", include_str!("../../../shaders/differential-composite/accumulate.wgsl")),
+        let masks = pipeline(
+            "composite masks",
+            &module("composite masks", include_str!("../../../shaders/differential-composite/masks.wgsl")),
         );
         let resolve = pipeline(
             "composite resolve",
@@ -189,11 +211,10 @@ impl GpuCompositor {
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             }),
-            accumulate,
+            masks,
             resolve,
             gbuffer: GBufferPass::new(gpu),
             mapper: ShadowMapper::new(gpu),
-            mask: Visibility::new(gpu, w, h, 1)?,
             size: (w, h),
         })
     }
@@ -253,60 +274,87 @@ impl GpuCompositor {
             subdivide_angle: None,
             ..ShadowSettings::default()
         };
-        // every map in one submission, then every mask and its share of the darkening in
-        // another (the passes reuse one mask layer, in order): two waits a frame, not one a map
+        // every map in one submission, into layers of as few texture arrays as the adapter
+        // allows; then every mask and its share of the darkening, one dispatch per array
         let t = Instant::now();
+        let lights: Vec<(ShadowLight, Technique)> = frame.reps.iter().map(|r| settings.map_light(c, r)).collect();
+        let limit = gpu.device.limits().max_texture_array_layers;
+        let views: Vec<u32> = lights.iter().map(|(l, t)| ShadowMapper::view_count(l, *t)).collect();
+        let batches = batches(&views, settings.layers_per_array.map_or(limit, |n| n.min(limit)));
+        let res = map_settings.resolution;
         let mut encoder = gpu.encoder("composite maps");
-        let maps = frame
-            .reps
-            .iter()
-            .map(|r| {
-                let (light, technique) = settings.map_light(c, r);
-                self.mapper.record(gpu, &mut encoder, &casters, &light, technique, &map_settings)
-            })
-            .collect::<Result<Vec<_>, _>>()?;
+        let mut arrays = Vec::with_capacity(batches.len());
+        let mut params: Vec<Vec<shadowmap_paraboloid::MapParams>> = Vec::with_capacity(batches.len());
+        let mut work = MapWork::default();
+        for (b, &(first, layers)) in batches.iter().enumerate() {
+            let end = batches.get(b + 1).map_or(lights.len(), |next| next.0);
+            let array = gpu::render_target(gpu, "composite shadow maps", (res, res, layers), DEPTH_FORMAT)?;
+            let mut layer = 0;
+            let mut mine = Vec::with_capacity(end - first);
+            for (light, technique) in &lights[first..end] {
+                let map = self.mapper.record(
+                    gpu,
+                    &mut encoder,
+                    &casters,
+                    light,
+                    *technique,
+                    &map_settings,
+                    Some((&array, layer)),
+                )?;
+                mine.push(map.lookup_params(0.0, layer));
+                layer += map.views.len() as u32;
+                work.views += map.views.len() as u32;
+                // a hemispherical light's paraboloid map has its front view alone
+                if map.technique == Technique::DualParaboloid
+                    && matches!(light, ShadowLight::Point { hemisphere: Some(_), .. })
+                {
+                    work.hemispheres_skipped += 2 - map.views.len() as u32;
+                }
+            }
+            arrays.push(array);
+            params.push(mine);
+        }
         gpu.submit_and_wait(encoder)?;
         times.shadow_maps = t.elapsed();
-        let mut work = MapWork::default();
-        for m in &maps {
-            work.views += m.views.len() as u32;
-            // a hemispherical light's paraboloid map has its front view alone
-            let hemispherical = matches!(m.light, ShadowLight::Point { hemisphere: Some(_), .. });
-            if m.technique == Technique::DualParaboloid && hemispherical {
-                work.hemispheres_skipped += 2 - m.views.len() as u32;
-            }
-        }
         let t = Instant::now();
-        let mask_view = self.mask.layer(0);
+        let position = gb.position.create_view(&wgpu::TextureViewDescriptor::default());
+        let normal = gb.geometric_normal.create_view(&wgpu::TextureViewDescriptor::default());
         let mut encoder = gpu.encoder("composite masks");
-        for (k, map) in maps.iter().enumerate() {
-            let params = AccumulateParams { width: w, height: h, slots: slots as u32, rep: k as u32 };
-            let uniform = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("accumulate params"),
-                contents: bytemuck::bytes_of(&params),
-                usage: wgpu::BufferUsages::UNIFORM,
+        for ((array, mine), &(first, _)) in arrays.iter().zip(&params).zip(&batches) {
+            let uniform = MaskParams {
+                width: w,
+                height: h,
+                slots: slots as u32,
+                reps: mine.len() as u32,
+                first_rep: first as u32,
+                pad: [0; 3],
+            };
+            let buffer = |label, contents: &[u8], usage| {
+                gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+            };
+            let uniform = buffer("mask params", bytemuck::bytes_of(&uniform), wgpu::BufferUsages::UNIFORM);
+            let maps = buffer("mask maps", bytemuck::cast_slice(mine), wgpu::BufferUsages::STORAGE);
+            let depth = array.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                aspect: wgpu::TextureAspect::DepthOnly,
+                ..Default::default()
             });
             let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("accumulate"),
-                layout: &self.accumulate.get_bind_group_layout(0),
+                label: Some("composite masks"),
+                layout: &self.masks.get_bind_group_layout(0),
                 entries: &[
                     wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 1, resource: self.pixels.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 2, resource: transfer_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&mask_view) },
-                    wgpu::BindGroupEntry { binding: 4, resource: self.darkening.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 3, resource: maps.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&depth) },
+                    wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&position) },
+                    wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::TextureView(&normal) },
+                    wgpu::BindGroupEntry { binding: 7, resource: self.darkening.as_entire_binding() },
                 ],
             });
-            self.mapper.record_visibility(
-                gpu,
-                &mut encoder,
-                map,
-                &gb,
-                shadowmap_paraboloid::VisibilityTarget::Layer(&mask_view),
-                0.0,
-            );
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor::default());
-            pass.set_pipeline(&self.accumulate);
+            pass.set_pipeline(&self.masks);
             pass.set_bind_group(0, &bind, &[]);
             pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
         }
@@ -373,4 +421,31 @@ impl GpuCompositor {
 
 fn pack(p: [u8; 3]) -> u32 {
     u32::from(p[0]) | (u32::from(p[1]) << 8) | (u32::from(p[2]) << 16) | (255 << 24)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::batches;
+
+    #[test]
+    fn batches_cover_every_map_in_order_within_the_limit() {
+        let views = [1, 6, 6, 2, 1, 6, 1];
+        for limit in [1, 6, 7, 12, 13, 100] {
+            let b = batches(&views, limit);
+            assert_eq!(b[0].0, 0);
+            for (k, &(first, layers)) in b.iter().enumerate() {
+                let end = b.get(k + 1).map_or(views.len(), |n| n.0);
+                assert!(end > first, "{limit}: an empty run");
+                assert_eq!(layers, views[first..end].iter().sum::<u32>(), "{limit}");
+                // within the limit, unless one map alone exceeds it
+                assert!(layers <= limit || end == first + 1, "{limit}: {b:?}");
+                // greedy: the next map would not have fitted
+                if end < views.len() {
+                    assert!(layers + views[end] > limit, "{limit}: {b:?}");
+                }
+            }
+        }
+        assert_eq!(batches(&views, 100), vec![(0, 23)]);
+        assert!(batches(&[], 8).is_empty());
+    }
 }

@@ -297,7 +297,7 @@ fn hemispherical_sources_render_one_paraboloid_view_and_cubes_six() {
     let s = room();
     let c = &s.compositor;
     let object = sphere(s, Vec3::new(0.0, 0.3, 0.5));
-    let frame = c.frame(&object, 20);
+    let frame = c.frame(&object, 0);
     let patches = frame
         .reps
         .iter()
@@ -307,14 +307,18 @@ fn hemispherical_sources_render_one_paraboloid_view_and_cubes_six() {
         .count() as u32;
     assert!(patches > 0 && patches as usize == frame.reps.len(), "{patches} of {}", frame.reps.len());
     let (g, gc) = gpu();
-    let run = |patch_maps| {
-        let settings = GpuSettings { patch_maps, ..GpuSettings::default() };
+    let run = |patch_maps, layers_per_array| {
+        let settings = GpuSettings { patch_maps, layers_per_array, ..GpuSettings::default() };
         gc.composite(g, c, &frame, &object, Mode::Hdr, &settings).unwrap_or_else(|e| panic!("{e}"))
     };
-    let (paraboloid, _, work) = run(shadowmap_paraboloid::Technique::DualParaboloid);
+    let (paraboloid, _, work) = run(shadowmap_paraboloid::Technique::DualParaboloid, None);
     assert_eq!((work.views, work.hemispheres_skipped), (patches, patches));
-    let (cube, _, work) = run(shadowmap_paraboloid::Technique::Cube);
+    let (cube, _, work) = run(shadowmap_paraboloid::Technique::Cube, None);
     assert_eq!((work.views, work.hemispheres_skipped), (6 * patches, 0));
+    // the maps spread over arrays of 16 layers (a dispatch each) darken as one array does
+    let (split, _, work) = run(shadowmap_paraboloid::Technique::Cube, Some(16));
+    assert_eq!(work.views, 6 * patches);
+    assert!(split.iter().zip(&cube).all(|(a, b)| (0..3).all(|ch| a[ch].abs_diff(b[ch]) <= 1)), "batches differ");
     // the hemisphere left out holds nothing the source lights: the composites agree
     let differ = paraboloid.iter().zip(&cube).filter(|(a, b)| (0..3).any(|ch| a[ch].abs_diff(b[ch]) > 2)).count();
     assert!((differ as f64) < 0.01 * paraboloid.len() as f64, "{differ} pixels differ");

@@ -8,8 +8,12 @@ use gpu::{Chunk, Clock, GBuffer, Gpu, GpuError, ShadowGeometry};
 use std::time::Duration;
 use wgpu::util::DeviceExt;
 
-const LIBRARY: &[(&str, &str)] =
-    &[("shadowmap-paraboloid/paraboloid.wgsl", include_str!("../../../shaders/shadowmap-paraboloid/paraboloid.wgsl"))];
+/// This crate's WGSL library files (for `// requires:` lines; shaders that read its maps use
+/// `lookup.wgsl`).
+pub const LIBRARY: &[(&str, &str)] = &[
+    ("shadowmap-paraboloid/paraboloid.wgsl", include_str!("../../../shaders/shadowmap-paraboloid/paraboloid.wgsl")),
+    ("shadowmap-paraboloid/lookup.wgsl", include_str!("../../../shaders/shadowmap-paraboloid/lookup.wgsl")),
+];
 
 /// Depth format of every shadow map: 32-bit float, readable back.
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -32,7 +36,7 @@ pub struct ShadowView {
 }
 
 #[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 struct ViewUniform {
     matrix: [[f32; 4]; 4],
     params: [f32; 4],
@@ -65,6 +69,9 @@ pub struct ShadowMap {
     pub time: Duration,
     /// The clock `time` comes from.
     pub clock: Clock,
+    /// The map's first layer in `texture` (0 unless recorded into a shared array,
+    /// [`ShadowMapper::record`]).
+    pub first_layer: u32,
 }
 
 impl ShadowMap {
@@ -79,8 +86,60 @@ impl ShadowMap {
     /// # Errors
     /// GPU failures.
     pub fn read_layer(&self, gpu: &Gpu, layer: u32) -> Result<Vec<f32>, GpuError> {
-        gpu::read_texture_f32(gpu, &self.texture, layer)
+        gpu::read_texture_f32(gpu, &self.texture, self.first_layer + layer)
     }
+
+    /// The map as `lookup.wgsl`'s `MapParams` (its layers at `first_layer` of the texture it is
+    /// bound with). `half_angle` (the light's, radians) is for PCSS on orthographic maps.
+    #[must_use]
+    pub fn lookup_params(&self, half_angle: f32, first_layer: u32) -> MapParams {
+        let (light, kind) = match self.light {
+            ShadowLight::Point { position, .. } => (position, 0.0),
+            ShadowLight::Distant { direction } => (direction.normalize_or(Vec3::Y), 1.0),
+        };
+        let technique = match self.technique {
+            Technique::DualParaboloid => 0.0,
+            Technique::Cube => 1.0,
+            Technique::Orthographic => 2.0,
+        };
+        let mut views = [bytemuck::Zeroable::zeroed(); 6];
+        for (slot, v) in views.iter_mut().zip(&self.views) {
+            *slot = v.uniform();
+        }
+        let forward = self.frame.map_or(Vec3::ZERO, |f| f.forward);
+        let (pcss, pcss_limits) = match self.settings.pcss {
+            Some(p) if self.technique == Technique::Orthographic => (
+                [
+                    1.0,
+                    half_angle.clamp(0.0, 1.5).tan(),
+                    p.blocker_samples.max(1) as f32,
+                    p.filter_samples.max(1) as f32,
+                ],
+                [p.max_radius_texels.max(1.0), 0.0, 0.0, 0.0],
+            ),
+            _ => ([0.0; 4], [0.0; 4]),
+        };
+        MapParams {
+            light: light.extend(kind).to_array(),
+            forward: forward.extend(first_layer as f32).to_array(),
+            config: [technique, self.views.len() as f32, self.settings.pcf_radius as f32, self.settings.bias_texels],
+            pcss,
+            pcss_limits,
+            views,
+        }
+    }
+}
+
+/// A map as `shaders/shadowmap-paraboloid/lookup.wgsl` reads it (`MapParams`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct MapParams {
+    light: [f32; 4],
+    forward: [f32; 4],
+    config: [f32; 4],
+    pcss: [f32; 4],
+    pcss_limits: [f32; 4],
+    views: [ViewUniform; 6],
 }
 
 /// Pipelines of the shadow passes, built once.
@@ -306,7 +365,7 @@ impl ShadowMapper {
         technique: Technique,
         settings: &ShadowSettings,
     ) -> Result<ShadowMap, GpuError> {
-        let mut p = self.prepare(gpu, geometry, light, technique, settings)?;
+        let mut p = self.prepare(gpu, geometry, light, technique, settings, None)?;
         let mut drawn = Vec::new();
         let (time, clock) = gpu.measure(|encoder| drawn = self.record_passes(encoder, geometry, &p))?;
         p.map.time = time;
@@ -315,11 +374,14 @@ impl ShadowMapper {
     }
 
     /// Records the shadow map of `light` into `encoder` without submitting it, so that many
-    /// maps (and the passes that read them) go to the GPU in one submission. Its `time` is zero:
-    /// the caller times the submission.
+    /// maps (and the passes that read them) go to the GPU in one submission; its `time` is zero
+    /// (the caller times the submission). `target`: layers `first..` of a `DEPTH_FORMAT` array of
+    /// `settings.resolution`² layers (e.g. one for all of a frame's maps, so that one pass can
+    /// read them all), or `None` for a texture of its own.
     ///
     /// # Errors
-    /// As [`ShadowMapper::render`].
+    /// As [`ShadowMapper::render`]; a target of another format or size, or without the layers.
+    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         gpu: &Gpu,
@@ -328,10 +390,23 @@ impl ShadowMapper {
         light: &ShadowLight,
         technique: Technique,
         settings: &ShadowSettings,
+        target: Option<(&wgpu::Texture, u32)>,
     ) -> Result<ShadowMap, GpuError> {
-        let p = self.prepare(gpu, geometry, light, technique, settings)?;
+        let p = self.prepare(gpu, geometry, light, technique, settings, target)?;
         let drawn = self.record_passes(encoder, geometry, &p);
         Ok(p.finish(drawn))
+    }
+
+    /// The views (texture layers) a map of `light` by `technique` has: a hemispherical
+    /// paraboloid 1, an omnidirectional one 2, a cube 6, an orthographic map 1.
+    #[must_use]
+    pub fn view_count(light: &ShadowLight, technique: Technique) -> u32 {
+        match (technique, light) {
+            (Technique::DualParaboloid, ShadowLight::Point { hemisphere: Some(_), .. }) => 1,
+            (Technique::DualParaboloid, _) => 2,
+            (Technique::Cube, _) => 6,
+            (Technique::Orthographic, _) => 1,
+        }
     }
 
     /// Everything a map's passes need, made before recording them.
@@ -342,6 +417,7 @@ impl ShadowMapper {
         light: &ShadowLight,
         technique: Technique,
         settings: &ShadowSettings,
+        target: Option<(&wgpu::Texture, u32)>,
     ) -> Result<Prepared<'_>, GpuError> {
         let mut settings = *settings;
         if self.paraboloid_clip.is_none() {
@@ -432,7 +508,26 @@ impl ShadowMapper {
             }
             (t, l) => return Err(GpuError::Failed(format!("a {t:?} shadow map does not fit a {l:?}"))),
         }
-        let texture = gpu::render_target(gpu, "shadow map", (res, res, views.len() as u32), DEPTH_FORMAT)?;
+        let layers = views.len() as u32;
+        let (texture, first_layer) = match target {
+            Some((t, first)) => {
+                let fits = t.format() == DEPTH_FORMAT
+                    && t.width() == res
+                    && t.height() == res
+                    && u64::from(first) + u64::from(layers) <= u64::from(t.depth_or_array_layers());
+                if !fits {
+                    return Err(GpuError::Failed(format!(
+                        "a {res}² map of {layers} layers does not fit layers {first}.. of a {:?} {} x {} x {} target",
+                        t.format(),
+                        t.width(),
+                        t.height(),
+                        t.depth_or_array_layers()
+                    )));
+                }
+                (t.clone(), first)
+            }
+            None => (gpu::render_target(gpu, "shadow map", (res, res, layers), DEPTH_FORMAT)?, 0),
+        };
         // (pipeline for chunks inside the view, pipeline for chunks across its edge)
         let (inside, straddle) = match (technique, settings.rejection, &self.paraboloid_clip) {
             (Technique::DualParaboloid, Rejection::ClipDistance, Some(p)) => (&self.paraboloid_plain, p),
@@ -440,7 +535,7 @@ impl ShadowMapper {
             _ => (&self.matrix, &self.matrix),
         };
         let layer_views: Vec<wgpu::TextureView> =
-            (0..views.len() as u32).map(|l| gpu::layer_view(&texture, l)).collect();
+            (0..layers).map(|l| gpu::layer_view(&texture, first_layer + l)).collect();
         let binds: Vec<wgpu::BindGroup> = views
             .iter()
             .map(|(v, _)| {
@@ -469,6 +564,7 @@ impl ShadowMapper {
             settings,
             time: std::time::Duration::ZERO,
             clock: gpu::Clock::WallTime,
+            first_layer,
         };
         Ok(Prepared { map, layer_views, binds, classes, inside, straddle })
     }
@@ -525,50 +621,8 @@ impl ShadowMapper {
         target: VisibilityTarget<'_>,
         half_angle: f32,
     ) {
-        #[repr(C)]
-        #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-        struct Params {
-            light: [f32; 4],
-            forward: [f32; 4],
-            config: [f32; 4],
-            pcss: [f32; 4],
-            pcss_limits: [f32; 4],
-            views: [ViewUniform; 6],
-        }
-        let (light, kind) = match map.light {
-            ShadowLight::Point { position, .. } => (position, 0.0),
-            ShadowLight::Distant { direction } => (direction.normalize_or(Vec3::Y), 1.0),
-        };
-        let technique = match map.technique {
-            Technique::DualParaboloid => 0.0,
-            Technique::Cube => 1.0,
-            Technique::Orthographic => 2.0,
-        };
-        let mut views = [bytemuck::Zeroable::zeroed(); 6];
-        for (slot, v) in views.iter_mut().zip(&map.views) {
-            *slot = v.uniform();
-        }
-        let forward = map.frame.map_or(Vec3::ZERO, |f| f.forward);
-        let (pcss, pcss_limits) = match map.settings.pcss {
-            Some(p) if map.technique == Technique::Orthographic => (
-                [
-                    1.0,
-                    half_angle.clamp(0.0, 1.5).tan(),
-                    p.blocker_samples.max(1) as f32,
-                    p.filter_samples.max(1) as f32,
-                ],
-                [p.max_radius_texels.max(1.0), 0.0, 0.0, 0.0],
-            ),
-            _ => ([0.0; 4], [0.0; 4]),
-        };
-        let params = Params {
-            light: light.extend(kind).to_array(),
-            forward: forward.extend(0.0).to_array(),
-            config: [technique, map.views.len() as f32, map.settings.pcf_radius as f32, map.settings.bias_texels],
-            pcss,
-            pcss_limits,
-            views,
-        };
+        // the view below starts at the map's first layer
+        let params = map.lookup_params(half_angle, 0);
         let buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("visibility params"),
             contents: bytemuck::bytes_of(&params),
@@ -579,6 +633,8 @@ impl ShadowMapper {
         let shadow = map.texture.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             aspect: wgpu::TextureAspect::DepthOnly,
+            base_array_layer: map.first_layer,
+            array_layer_count: Some(map.views.len() as u32),
             ..Default::default()
         });
         let pipeline = match target {

@@ -326,12 +326,22 @@ fn maps_recorded_into_one_submission_equal_maps_rendered_one_by_one() {
         (ShadowLight::omni(p - Vec3::X), Technique::Cube),
         (ShadowLight::Distant { direction: Vec3::new(0.3, 1.0, 0.2) }, Technique::Orthographic),
     ];
+    // the first two into one shared array (its layers 1.. : layer 0 stays unused), the others
+    // into textures of their own
+    let shared = gpu::render_target(&s.gpu, "shared", (64, 64, 4), shadowmap_paraboloid::DEPTH_FORMAT).unwrap();
     let mut encoder = s.gpu.encoder("batch");
-    let batched: Vec<ShadowMap> = lights
-        .iter()
-        .map(|(l, t)| s.mapper.record(&s.gpu, &mut encoder, &geometry, l, *t, &settings).unwrap())
-        .collect();
+    let mut batched: Vec<ShadowMap> = Vec::new();
+    for (k, (l, t)) in lights.iter().enumerate() {
+        let target = (k < 2).then(|| (&shared, 1 + batched.iter().map(|m| m.views.len() as u32).sum::<u32>()));
+        batched.push(s.mapper.record(&s.gpu, &mut encoder, &geometry, l, *t, &settings, target).unwrap());
+    }
     s.gpu.submit_and_wait(encoder).unwrap();
+    assert_eq!((batched[0].first_layer, batched[1].first_layer), (1, 3));
+    // a target without room for the map is refused, not overrun
+    let mut encoder = s.gpu.encoder("too small");
+    let e =
+        s.mapper.record(&s.gpu, &mut encoder, &geometry, &lights[2].0, Technique::Cube, &settings, Some((&shared, 0)));
+    assert!(e.is_err(), "six cube faces in a four-layer array");
     for ((l, t), b) in lights.iter().zip(&batched) {
         let alone = s.mapper.render(&s.gpu, &geometry, l, *t, &settings).unwrap();
         assert_eq!(b.views.len(), alone.views.len(), "{t:?}");
