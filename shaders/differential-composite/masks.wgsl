@@ -52,13 +52,22 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let ng = textureLoad(g_geometric_normal, vec2<i32>(id.xy), 0).xyz;
     var sum = vec4<f32>(0.0);
     for (var r = 0u; r < params.reps; r++) {
-        let m = maps[r];
-        let blocked = 1.0 - map_lit(m, shadow_maps, map_receiver(m, g.xyz, ng));
-        if blocked > 0.0 {
+        // the map's fields and the one view the receiver needs, not the whole record
+        let light = maps[r].light;
+        let forward = maps[r].forward;
+        let config = maps[r].config;
+        let rec = map_receiver(light, config, maps[r].views[0].params, g.xyz, ng);
+        let layer = map_layer(light, forward, config, rec.p);
+        var lit = 0.0;
+        if layer != NO_LAYER {
+            let technique = u32(config.x);
+            lit = view_lit(maps[r].views[layer], technique, i32(config.z), shadow_maps, i32(layer + u32(forward.w)), rec.p);
+        }
+        if lit < 1.0 {
             let base = (params.first_rep + r) * params.slots + px.slot;
             let t = px.weights.x * transfers[base] + px.weights.y * transfers[base + 1u]
                 + px.weights.z * transfers[base + 2u] + px.weights.w * transfers[base + 3u];
-            sum += blocked * t;
+            sum += (1.0 - lit) * t;
         }
     }
     darkening[k] += sum;

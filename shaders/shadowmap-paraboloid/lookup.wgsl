@@ -32,22 +32,20 @@ fn cube_face(d: vec3<f32>) -> u32 {
     return select(5u, 4u, d.z >= 0.0);
 }
 
-// Fraction of the (2r + 1)^2 texels around `uv` (in [-1, 1], +v up) of the map's layer `layer`
-// whose depth is not less than `depth`. A receiver beyond the map's far plane lies behind
-// whatever the map holds there (a map of a few casters over distant receivers), so its depth is
-// taken as the far plane's.
-fn lit_fraction(m: MapParams, maps: texture_depth_2d_array, uv: vec2<f32>, depth_in: f32, layer: u32) -> f32 {
+// Fraction of the (2r + 1)^2 texels around `uv` (in [-1, 1], +v up) of the texture's layer
+// `layer` (a view of `view`'s resolution) whose depth is not less than `depth`. A receiver
+// beyond the map's far plane lies behind whatever the map holds there (a map of a few casters
+// over distant receivers), so its depth is taken as the far plane's.
+fn lit_fraction(view: ShadowView, maps: texture_depth_2d_array, layer: i32, r: i32, uv: vec2<f32>, depth_in: f32) -> f32 {
     let depth = min(depth_in, 1.0);
-    let res = i32(m.views[layer].params.w);
+    let res = i32(view.params.w);
     let x = i32(floor((uv.x * 0.5 + 0.5) * f32(res)));
     let y = i32(floor((0.5 - uv.y * 0.5) * f32(res)));
-    let r = i32(m.config.z);
-    let base = layer + u32(m.forward.w);
     var lit = 0.0;
     for (var dy = -r; dy <= r; dy++) {
         for (var dx = -r; dx <= r; dx++) {
             let t = clamp(vec2<i32>(x + dx, y + dy), vec2<i32>(0), vec2<i32>(res - 1));
-            let stored = textureLoad(maps, t, i32(base), 0);
+            let stored = textureLoad(maps, t, layer, 0);
             lit += select(0.0, 1.0, depth <= stored);
         }
     }
@@ -62,12 +60,16 @@ struct MapReceiver {
     to_light: vec3<f32>,
 }
 
-fn map_receiver(m: MapParams, g: vec3<f32>, ng_in: vec3<f32>) -> MapReceiver {
-    let is_distant = m.light.w > 0.5;
-    var to_light = m.light.xyz;
+// The functions below take a map's fields rather than a whole `MapParams`: a pass that loops
+// over many maps in a storage buffer then loads only the fields and the one view it needs.
+
+// `light`, `config`: the map's; `view0`: its first view's `params` (resolution, extent).
+fn map_receiver(light: vec4<f32>, config: vec4<f32>, view0: vec4<f32>, g: vec3<f32>, ng_in: vec3<f32>) -> MapReceiver {
+    let is_distant = light.w > 0.5;
+    var to_light = light.xyz;
     var dist = 1.0;
     if !is_distant {
-        to_light = m.light.xyz - g;
+        to_light = light.xyz - g;
         dist = length(to_light);
         to_light = to_light / max(dist, 1e-30);
     }
@@ -75,44 +77,51 @@ fn map_receiver(m: MapParams, g: vec3<f32>, ng_in: vec3<f32>) -> MapReceiver {
     if dot(ng, to_light) < 0.0 {
         ng = -ng;
     }
-    let technique = u32(m.config.x);
-    let res = m.views[0].params.w;
+    let technique = u32(config.x);
+    let res = view0.w;
     // world size of one texel at the receiver: paraboloid 4/res rad at the centre, cube 2/res
     // rad at a face centre, orthographic extent / res
     var texel = dist * 4.0 / res;
     if technique == 1u {
         texel = dist * 2.0 / res;
     } else if technique == 2u {
-        texel = m.views[0].params.y / res;
+        texel = view0.y / res;
     }
-    let offset = m.config.w * texel;
+    let offset = config.w * texel;
     return MapReceiver(g + ng * offset + to_light * offset, ng, to_light);
 }
 
-// The receiver's visibility through the map: 1 lit, 0 shadowed, fractions with PCF; 0 behind a
-// hemispherical light (it does not emit there); 1 outside an orthographic map's footprint or
-// between the light and its near plane (nothing there can shadow it).
-fn map_lit(m: MapParams, maps: texture_depth_2d_array, r: MapReceiver) -> f32 {
-    let technique = u32(m.config.x);
+// No layer: the receiver lies behind a hemispherical light, which does not emit there.
+const NO_LAYER: u32 = 0xffffffffu;
+
+// The map's layer that sees `p`: the paraboloid hemisphere, the cube face, the one
+// orthographic view; `NO_LAYER` behind a hemispherical light.
+fn map_layer(light: vec4<f32>, forward: vec4<f32>, config: vec4<f32>, p: vec3<f32>) -> u32 {
+    let technique = u32(config.x);
     if technique == 0u {
-        var layer = 0u;
-        if dot(r.p - m.light.xyz, m.forward.xyz) < 0.0 {
-            if m.config.y < 1.5 {
-                return 0.0;
-            }
-            layer = 1u;
+        if dot(p - light.xyz, forward.xyz) < 0.0 {
+            return select(1u, NO_LAYER, config.y < 1.5);
         }
-        let c = paraboloid_project(m.views[layer], r.p);
-        return lit_fraction(m, maps, c.xy, c.z, layer);
+        return 0u;
     }
-    var layer = 0u;
     if technique == 1u {
-        layer = cube_face(r.p - m.light.xyz);
+        return cube_face(p - light.xyz);
     }
-    let clip = m.views[layer].matrix * vec4<f32>(r.p, 1.0);
+    return 0u;
+}
+
+// `p`'s visibility through `view` (texture layer `layer`): 1 lit, 0 shadowed, fractions with
+// a PCF radius `pcf`; 1 outside an orthographic view's footprint or between the light and its
+// near plane (nothing there can shadow it).
+fn view_lit(view: ShadowView, technique: u32, pcf: i32, maps: texture_depth_2d_array, layer: i32, p: vec3<f32>) -> f32 {
+    if technique == 0u {
+        let c = paraboloid_project(view, p);
+        return lit_fraction(view, maps, layer, pcf, c.xy, c.z);
+    }
+    let clip = view.matrix * vec4<f32>(p, 1.0);
     let ndc = clip.xyz / clip.w;
     if technique == 2u && (any(abs(ndc.xy) > vec2<f32>(1.0)) || ndc.z < 0.0) {
         return 1.0;
     }
-    return lit_fraction(m, maps, ndc.xy, ndc.z, layer);
+    return lit_fraction(view, maps, layer, pcf, ndc.xy, ndc.z);
 }

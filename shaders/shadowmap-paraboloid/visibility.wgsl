@@ -72,8 +72,9 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     if g.w < 0.0 {
         return vec4<f32>(1.0);
     }
-    let r = map_receiver(params, g.xyz, textureLoad(g_geometric_normal, pixel, 0).xyz);
-    if u32(params.config.x) == 2u && params.pcss.x > 0.5 {
+    let r = map_receiver(params.light, params.config, params.views[0].params, g.xyz, textureLoad(g_geometric_normal, pixel, 0).xyz);
+    let technique = u32(params.config.x);
+    if technique == 2u && params.pcss.x > 0.5 {
         let clip = params.views[0].matrix * vec4<f32>(r.p, 1.0);
         let ndc = clip.xyz / clip.w;
         if any(abs(ndc.xy) > vec2<f32>(1.0)) || ndc.z < 0.0 {
@@ -87,5 +88,10 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
         let spin = 6.2831853 * fract(52.9829189 * fract(dot(frag.xy, vec2<f32>(0.06711056, 0.00583715))));
         return vec4<f32>(pcss(ndc.xy, min(ndc.z, 1.0), slope, spin));
     }
-    return vec4<f32>(map_lit(params, shadow_map, r));
+    let layer = map_layer(params.light, params.forward, params.config, r.p);
+    if layer == NO_LAYER {
+        return vec4<f32>(0.0);
+    }
+    // the bound view starts at the map's first layer
+    return vec4<f32>(view_lit(params.views[layer], technique, i32(params.config.z), shadow_map, i32(layer), r.p));
 }
