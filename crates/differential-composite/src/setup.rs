@@ -139,7 +139,16 @@ impl Session {
     /// # Errors
     /// As [`crate::offline::truth`].
     pub fn truth(&self, object: &SyntheticObject) -> Result<Vec<[u8; 3]>, CompositeError> {
-        let hdr = crate::offline::truth(&self.real, object, self.map.as_ref(), &self.settings.photo)?;
+        self.truth_with(object, &self.settings.photo)
+    }
+
+    /// The truth for `object` path traced with `photo` (e.g. another seed, for the truth's
+    /// own noise), through the response.
+    ///
+    /// # Errors
+    /// As [`crate::offline::truth`].
+    pub fn truth_with(&self, object: &SyntheticObject, photo: &PhotoSettings) -> Result<Vec<[u8; 3]>, CompositeError> {
+        let hdr = crate::offline::truth(&self.real, object, self.map.as_ref(), photo)?;
         Ok(hdr.iter().map(|c| self.compositor.response.apply(*c)).collect())
     }
 

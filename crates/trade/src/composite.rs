@@ -52,12 +52,7 @@ impl CompositeCase {
         let session = Session::new(scene_name, map, lights, &settings).map_err(e)?;
         let object = session.object("sphere", object_position(scene_name)).map_err(e)?;
         let truth = session.truth(&object).map_err(e)?;
-        let second = {
-            let photo = PhotoSettings { seed: photo.seed + 7919, ..photo };
-            let hdr = differential_composite::offline::truth(&session.real, &object, session.map.as_ref(), &photo)
-                .map_err(e)?;
-            hdr.iter().map(|c| session.compositor.response.apply(*c)).collect::<Vec<_>>()
-        };
+        let second = session.truth_with(&object, &PhotoSettings { seed: photo.seed + 7919, ..photo }).map_err(e)?;
         let truth_noise =
             code_error(&second, &truth, &session.compositor.photo_ldr).rmse_changed / std::f64::consts::SQRT_2;
         let compositor = GpuCompositor::new(gpu, &session.compositor)?;
