@@ -345,6 +345,8 @@ fn maps_recorded_into_one_submission_equal_maps_rendered_one_by_one() {
     for ((l, t), b) in lights.iter().zip(&batched) {
         let alone = s.mapper.render(&s.gpu, &geometry, l, *t, &settings).unwrap();
         assert_eq!(b.views.len(), alone.views.len(), "{t:?}");
+        // what a batch sizes its array by before recording
+        assert_eq!(ShadowMapper::view_count(l, *t) as usize, alone.views.len(), "{t:?}");
         for layer in 0..alone.views.len() as u32 {
             let (x, y) = (b.read_layer(&s.gpu, layer).unwrap(), alone.read_layer(&s.gpu, layer).unwrap());
             assert!(x.iter().any(|d| *d < 1.0), "{t:?} layer {layer}: nothing drawn");
