@@ -120,7 +120,7 @@ impl Unit {
 /// The family a scene is measured in: composites for real scenes, point for scenes with point
 /// lights, env for the rest.
 fn family_of(scene: &str) -> Result<Family, String> {
-    if real_scene::RealScene::builtin(scene).is_ok() {
+    if real_scene::BUILTIN_REAL_SCENES.contains(&scene) {
         return Ok(Family::Composite);
     }
     let s = scene::Scene::builtin(scene).map_err(|e| format!("--scenes: {e}"))?;

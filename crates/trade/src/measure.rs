@@ -19,7 +19,7 @@ use ref_tracer::metrics::{FlipTonemap, flip, rmse};
 use ref_tracer::{EnvLight, Integrator, RenderSettings, SceneBvh, Strategy};
 use shadowmap_paraboloid::MapTechnique;
 use std::collections::HashMap;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 /// How a run measures.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -260,39 +260,25 @@ pub fn measure(
             specular,
             supersample: plan.supersample.max(1),
         };
-        // pipelines compile and buffers grow on the first frame: a median of 3 or more drops
-        // it, fewer repeats get an untimed frame first
-        let mut last = if plan.repeats < 3 { Some(frame(gpu, &input, setting, technique.as_deref())?) } else { None };
-        let mut times = Vec::new();
-        for _ in 0..plan.repeats.max(1) {
-            let t = Instant::now();
-            let (image, reports) = frame(gpu, &input, setting, technique.as_deref())?;
-            times.push(t.elapsed());
-            last = Some((image, reports));
-        }
-        times.sort();
-        let (image, reports) = last.ok_or_else(|| TradeError::Render("no frame".into()))?;
+        let ((image, reports), ms) = timed(plan, || frame(gpu, &input, setting, technique.as_deref()))?;
         let image = grid.resolve(&gpu::read_hdr(gpu, &image)?);
-        let (shadow_time, shadowed, _, _) = gpu::totals(&reports);
-        let shadow_clock = reports.iter().find_map(|r| r.clock).map_or("none (no shadow pass)", gpu::Clock::name);
-        let culled = gpu::culled_totals(&reports).into_iter().map(|(w, n)| (w.to_string(), n)).collect();
-        let skipped = gpu::skip_reasons(&reports);
+        let shadows = Shadows::of(&reports);
         let m = Measurement {
             setting: knobs.name(),
             knobs: knobs.clone(),
             scene: case.scene.name.clone(),
             map: case.map_name.clone(),
-            ms: median_ms(&times),
-            clock: "wall time (frame: submits + waits, the G-buffer's points read back)".into(),
-            shadow_ms: shadow_time.as_secs_f64() * 1e3,
-            shadow_clock: shadow_clock.into(),
+            ms,
+            clock: FRAME_CLOCK.into(),
+            shadow_ms: shadows.ms,
+            shadow_clock: shadows.clock,
             extract_ms,
             rmse: rmse(&case.truth, &image),
             flip: flip(&case.truth, &image, w, h, &case.tonemap),
             truth_noise: case.truth_noise,
-            shadowed,
-            skipped,
-            culled,
+            shadowed: shadows.shadowed,
+            skipped: shadows.skipped,
+            culled: shadows.culled,
             pareto: false,
         };
         progress(&m);
@@ -301,6 +287,43 @@ pub fn measure(
     Ok(out)
 }
 
-pub(crate) fn median_ms(times: &[Duration]) -> f64 {
-    times.get(times.len() / 2).map_or(f64::NAN, |t| t.as_secs_f64() * 1e3)
+/// What an env or point frame's `ms` measures.
+pub(crate) const FRAME_CLOCK: &str = "wall time (frame: submits + waits, the G-buffer's points read back)";
+
+/// `plan.repeats` frames of `frame` timed: the last frame and the median milliseconds.
+/// Pipelines compile and buffers grow on the first frame: a median of 3 or more drops it,
+/// fewer repeats get an untimed frame first.
+pub(crate) fn timed<T>(plan: &Plan, mut frame: impl FnMut() -> Result<T, TradeError>) -> Result<(T, f64), TradeError> {
+    let mut last = if plan.repeats < 3 { Some(frame()?) } else { None };
+    let mut times = Vec::new();
+    for _ in 0..plan.repeats.max(1) {
+        let t = Instant::now();
+        last = Some(frame()?);
+        times.push(t.elapsed());
+    }
+    times.sort();
+    let ms = times.get(times.len() / 2).map_or(f64::NAN, |t| t.as_secs_f64() * 1e3);
+    Ok((last.ok_or_else(|| TradeError::Render("no frame".into()))?, ms))
+}
+
+/// A frame's shadow reports as a measurement states them.
+pub(crate) struct Shadows {
+    pub(crate) ms: f64,
+    pub(crate) clock: String,
+    pub(crate) shadowed: usize,
+    pub(crate) skipped: Vec<(String, usize)>,
+    pub(crate) culled: Vec<(String, u64)>,
+}
+
+impl Shadows {
+    pub(crate) fn of(reports: &[ShadowPassReport]) -> Self {
+        let (time, shadowed, _, _) = gpu::totals(reports);
+        Self {
+            ms: time.as_secs_f64() * 1e3,
+            clock: reports.iter().find_map(|r| r.clock).map_or("none (no shadow pass)", gpu::Clock::name).into(),
+            shadowed,
+            skipped: gpu::skip_reasons(reports),
+            culled: gpu::culled_totals(reports).into_iter().map(|(w, n)| (w.to_string(), n)).collect(),
+        }
+    }
 }

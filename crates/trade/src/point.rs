@@ -5,7 +5,7 @@
 
 use crate::TradeError;
 use crate::front::Measurement;
-use crate::measure::{Passes, Plan, median_ms, technique};
+use crate::measure::{FRAME_CLOCK, Passes, Plan, Shadows, technique, timed};
 use crate::setting::Setting;
 use glam::Vec3;
 use gpu::{
@@ -15,7 +15,6 @@ use gpu::{
 use ref_tracer::SceneBvh;
 use ref_tracer::metrics::{FlipTonemap, flip, rmse};
 use ref_tracer::visibility::{VisibilityLight, light_visibility};
-use std::time::Instant;
 
 /// A built-in scene with point lights, and its truth.
 pub struct PointCase {
@@ -111,34 +110,25 @@ pub fn measure_point(
         let technique = technique(gpu, &case.scene, &setting.shadow)?
             .filter(|_| setting.shadow.for_point_lights())
             .ok_or_else(|| TradeError::Render(format!("{}: not a point-light technique", knobs.name())))?;
-        let mut last = if plan.repeats < 3 { Some(case.frame(gpu, passes, technique.as_ref())?) } else { None };
-        let mut times = Vec::new();
-        for _ in 0..plan.repeats.max(1) {
-            let t = Instant::now();
-            let f = case.frame(gpu, passes, technique.as_ref())?;
-            times.push(t.elapsed());
-            last = Some(f);
-        }
-        times.sort();
-        let (image, reports) = last.ok_or_else(|| TradeError::Render("no frame".into()))?;
+        let ((image, reports), ms) = timed(plan, || case.frame(gpu, passes, technique.as_ref()))?;
         let image = case.grid.resolve(&gpu::read_hdr(gpu, &image)?);
-        let (shadow_time, shadowed, _, _) = gpu::totals(&reports);
+        let shadows = Shadows::of(&reports);
         let m = Measurement {
             setting: knobs.name(),
             knobs: knobs.clone(),
             scene: case.scene.name.clone(),
             map: "-".into(),
-            ms: median_ms(&times),
-            clock: "wall time (frame: submits + waits, the G-buffer's points read back)".into(),
-            shadow_ms: shadow_time.as_secs_f64() * 1e3,
-            shadow_clock: reports.iter().find_map(|r| r.clock).map_or("none (no shadow pass)", gpu::Clock::name).into(),
+            ms,
+            clock: FRAME_CLOCK.into(),
+            shadow_ms: shadows.ms,
+            shadow_clock: shadows.clock,
             extract_ms: 0.0,
             rmse: rmse(&case.truth, &image),
             flip: flip(&case.truth, &image, w, h, &case.tonemap),
             truth_noise: 0.0,
-            shadowed,
-            skipped: gpu::skip_reasons(&reports),
-            culled: gpu::culled_totals(&reports).into_iter().map(|(w, n)| (w.to_string(), n)).collect(),
+            shadowed: shadows.shadowed,
+            skipped: shadows.skipped,
+            culled: shadows.culled,
             pareto: false,
         };
         progress(&m);

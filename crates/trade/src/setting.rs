@@ -311,15 +311,21 @@ impl CompositeSetting {
         Self { passes, ldr, patch_maps: PatchMaps::Paraboloid, map_resolution: 256 }
     }
 
-    /// `composite/50/hdr/paraboloid_256` (`all` for one pass per occluded source).
+    /// The patches' maps: `paraboloid_256`, `cube_256`.
     #[must_use]
-    pub fn name(&self) -> String {
-        let passes = if self.passes == 0 { "all".to_string() } else { self.passes.to_string() };
+    pub fn maps_name(&self) -> String {
         let maps = match self.patch_maps {
             PatchMaps::Paraboloid => "paraboloid",
             PatchMaps::Cube => "cube",
         };
-        format!("composite/{passes}/{}/{maps}_{}", if self.ldr { "ldr" } else { "hdr" }, self.map_resolution)
+        format!("{maps}_{}", self.map_resolution)
+    }
+
+    /// `composite/50/hdr/paraboloid_256` (`all` for one pass per occluded source).
+    #[must_use]
+    pub fn name(&self) -> String {
+        let passes = if self.passes == 0 { "all".to_string() } else { self.passes.to_string() };
+        format!("composite/{passes}/{}/{}", if self.ldr { "ldr" } else { "hdr" }, self.maps_name())
     }
 }
 

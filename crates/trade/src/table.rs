@@ -72,7 +72,7 @@ impl Run {
                 Setting::Composite(c) => (
                     none(),
                     none(),
-                    c.name().rsplit('/').next().unwrap_or_default().to_string(),
+                    c.maps_name(),
                     none(),
                     none(),
                     if c.passes == 0 { "all".to_string() } else { c.passes.to_string() },
