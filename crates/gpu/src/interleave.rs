@@ -5,7 +5,14 @@
 //! into one image: the shadow work is n times one set's.
 
 use crate::context::{Gpu, GpuError};
+use crate::geometry::SceneGeometry;
+use crate::shade::{ShadeLight, ShadeParams, ShadingPass, Visibility};
+use crate::technique::{LightShape, Receivers, ShadowPassReport, ShadowTechnique, render_visibility};
+use scene::DistantLight;
 use wgpu::util::DeviceExt;
+
+/// The most light sets [`render_interleaved`] takes (each is a whole frame's shadow work).
+pub const MAX_SETS: u32 = 256;
 
 /// The tile (a, b) of `sets` sets: b the largest divisor of `sets` not above its square root.
 #[must_use]
@@ -73,4 +80,61 @@ impl InterleavePass {
         });
         crate::fullscreen::draw_over(gpu, &self.pipeline, &bind, &dst.create_view(&Default::default()))
     }
+}
+
+/// What every set of an interleaved frame shares: the G-buffer's receivers, the shading
+/// parameters (their `lights` are replaced by each set's) and the lights skipped by Weber's law
+/// (by index, the same in every set: a set perturbs the lights, it does not reorder them).
+pub struct InterleavedFrame<'a> {
+    /// The scene on the GPU.
+    pub geometry: &'a SceneGeometry,
+    /// The frame's G-buffer and its points.
+    pub receivers: &'a Receivers<'a>,
+    /// Ambient, background and specular ambient; `lights` is ignored.
+    pub params: &'a ShadeParams<'a>,
+    /// Lights whose shadows are skipped, by index (may be empty).
+    pub negligible: &'a [bool],
+}
+
+/// Paper 001's interleaved sampling on the GPU: each light set of `sets` shadowed by
+/// `technique` and shaded whole, its pixels of the interleaving tile gathered into one image.
+/// Returns the image (on the GPU, [`crate::HDR_FORMAT`]) and every set's shadow reports, set
+/// after set.
+///
+/// # Errors
+/// [`GpuError::Failed`] for no set; [`GpuError::TooLarge`] for more than [`MAX_SETS`]; GPU
+/// failures.
+pub fn render_interleaved(
+    gpu: &Gpu,
+    pass: &ShadingPass,
+    frame: &InterleavedFrame,
+    technique: &dyn ShadowTechnique,
+    sets: &[Vec<DistantLight>],
+) -> Result<(wgpu::Texture, Vec<ShadowPassReport>), GpuError> {
+    if sets.is_empty() {
+        return Err(GpuError::Failed("interleaving: no light set".into()));
+    }
+    let gb = frame.receivers.gbuffer;
+    let (w, h) = gb.size();
+    if sets.len() > MAX_SETS as usize {
+        return Err(GpuError::TooLarge {
+            what: "interleaved light sets",
+            size: sets.len() as u64,
+            limit: MAX_SETS.into(),
+        });
+    }
+    let n = sets.len() as u32;
+    let gathered = crate::render_target(gpu, "interleaved", (w, h, 1), crate::HDR_FORMAT)?;
+    let gather = InterleavePass::new(gpu);
+    let mut reports = Vec::new();
+    for (k, set) in (0..n).zip(sets) {
+        let lights: Vec<ShadeLight> = set.iter().map(ShadeLight::from).collect();
+        let shapes: Vec<LightShape> = set.iter().map(LightShape::from).collect();
+        let vis = Visibility::new(gpu, w, h, lights.len().max(1) as u32)?;
+        reports.extend(render_visibility(gpu, technique, frame.receivers, &shapes, frame.negligible, &vis)?);
+        let params = ShadeParams { lights: &lights, ..*frame.params };
+        let image = pass.render_texture(gpu, frame.geometry, gb, &params, &vis)?;
+        gather.gather(gpu, &image, &gathered, n, k)?;
+    }
+    Ok((gathered, reports))
 }

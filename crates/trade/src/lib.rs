@@ -17,6 +17,7 @@
 //! never share a front or a choice (their errors are against different truths). Library code:
 //! no printing, progress goes to a callback.
 
+pub mod banding;
 pub mod composite;
 pub mod front;
 pub mod measure;
@@ -26,6 +27,7 @@ pub mod setting;
 pub mod shard;
 pub mod table;
 
+pub use banding::{BandingCase, BandingRow, Interleave, measure_banding};
 pub use composite::{CompositeCase, measure_composite};
 pub use front::{ChooseError, Measurement, Point, choose, front as pareto_front, mark_fronts, overall, pareto};
 pub use measure::{Case, Passes, Plan, measure};

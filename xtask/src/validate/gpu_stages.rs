@@ -7,12 +7,11 @@ use super::{MaskRow, Plan};
 use envmap_sphere::EnvMap;
 use glam::Vec3;
 use gpu::{
-    Background, GBufferPass, Gpu, InterleavePass, JointBilateral, LightShape, PrecomputedVisibility, PrefilterSettings,
-    Receivers, SceneGeometry, ShadeLight, ShadeParams, ShadingPass, ShadowGeometry, ShadowTechnique, SpecularAmbient,
-    SplitFrame, SplitPasses, SplitSettings, UpsamplePass, Visibility, WEBER_FRACTION, render_split, render_visibility,
-    weber_negligible,
+    Background, GBufferPass, Gpu, InterleavedFrame, JointBilateral, LightShape, PrecomputedVisibility,
+    PrefilterSettings, Receivers, SceneGeometry, ShadeLight, ShadeParams, ShadingPass, ShadowGeometry, ShadowTechnique,
+    SpecularAmbient, SplitFrame, SplitPasses, SplitSettings, UpsamplePass, Visibility, WEBER_FRACTION,
+    render_interleaved, render_split, render_visibility, weber_negligible,
 };
-use light_extract::ExtractedLight;
 use penumbra_wedge::{WedgeSettings, Wedges};
 use ref_tracer::SceneBvh;
 use ref_tracer::visibility::{AreaLight, VisibilityLight, Weighting, area_light_visibility_refined, light_visibility};
@@ -217,11 +216,19 @@ pub(super) fn gpu_render(
         }
     }
     if plan.interleaved {
-        let sets: Vec<Vec<ExtractedLight>> = std::iter::once(d.lights.clone()).chain(d.interleaved()).collect();
+        let sets: Vec<Vec<scene::DistantLight>> =
+            std::iter::once(d.distant_lights()).chain(d.interleaved_distant_lights()).collect();
         for (name, technique) in all.iter().filter(|(n, _)| n == "gpu_shadow_maps" || n == "gpu_wedges") {
             let t = Instant::now();
-            let frame = Frame { geometry: &geometry, receivers: &receivers, params: &params, negligible: &negligible };
-            let (image, ms) = interleaved(gpu, pass, &frame, technique.as_ref(), &sets).map_err(e)?;
+            let frame = InterleavedFrame {
+                geometry: &geometry,
+                receivers: &receivers,
+                params: &params,
+                negligible: &negligible,
+            };
+            let (image, reports) = render_interleaved(gpu, pass, &frame, technique.as_ref(), &sets).map_err(e)?;
+            let ms = gpu::totals(&reports).0.as_secs_f64() * 1e3;
+            let image = gpu::read_hdr(gpu, &image).map_err(e)?;
             out.push(GpuImage {
                 name: format!("{name}_interleaved"),
                 what: format!(
@@ -246,42 +253,6 @@ pub(super) fn gpu_render(
         seconds: 0.0,
     });
     Ok(out)
-}
-
-/// What every set of an interleaved frame shares.
-struct Frame<'a> {
-    geometry: &'a SceneGeometry,
-    receivers: &'a Receivers<'a>,
-    params: &'a ShadeParams<'a>,
-    negligible: &'a [bool],
-}
-
-/// Paper 001's interleaved sampling on the GPU: each light set shadowed by `technique` and
-/// shaded whole, its pixels of the interleaving tile gathered into one image. Returns the image
-/// and the shadow passes' time in ms.
-fn interleaved(
-    gpu: &Gpu,
-    pass: &ShadingPass,
-    frame: &Frame,
-    technique: &dyn ShadowTechnique,
-    sets: &[Vec<ExtractedLight>],
-) -> Result<(Vec<Vec3>, f64), gpu::GpuError> {
-    let gb = frame.receivers.gbuffer;
-    let (w, h) = gb.size();
-    let gathered = gpu::render_target(gpu, "interleaved", (w, h, 1), gpu::HDR_FORMAT)?;
-    let gather = InterleavePass::new(gpu);
-    let mut ms = 0.0;
-    for (k, set) in sets.iter().enumerate() {
-        let lights: Vec<ShadeLight> = set.iter().map(|l| ShadeLight::from(&l.light)).collect();
-        let shapes: Vec<LightShape> = set.iter().map(|l| LightShape::from(&l.light)).collect();
-        let vis = Visibility::new(gpu, w, h, lights.len() as u32)?;
-        let reports = render_visibility(gpu, technique, frame.receivers, &shapes, frame.negligible, &vis)?;
-        ms += gpu::totals(&reports).0.as_secs_f64() * 1e3;
-        let params = ShadeParams { lights: &lights, ..*frame.params };
-        let image = pass.render_texture(gpu, frame.geometry, gb, &params, &vis)?;
-        gather.gather(gpu, &image, &gathered, sets.len() as u32, k as u32)?;
-    }
-    Ok((gpu::read_hdr(gpu, &gathered)?, ms))
 }
 
 /// ", N skipped: why" per reason, or nothing.
