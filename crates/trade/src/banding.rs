@@ -243,6 +243,8 @@ pub struct BandingRow {
     /// The frame's wall time, ms: G-buffer (its points read back), shadows, shading, gathering,
     /// the image read back.
     pub frame_ms: f64,
+    /// The frame, resolved to the output's pixels.
+    pub image: Vec<Vec3>,
 }
 
 /// Renders `case` with its lights shadowed by `shadow` on a rotated grid of `supersample`² + 1
@@ -318,5 +320,6 @@ pub fn measure_banding(
         banding: banding(&image, case.scene.camera.width as usize, &case.truth, f64::from(WEBER_FRACTION), scale),
         shadow_ms: gpu::totals(&reports).0.as_secs_f64() * 1e3,
         frame_ms,
+        image,
     })
 }

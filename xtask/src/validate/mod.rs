@@ -5,6 +5,7 @@
 //! time them, write `target/validate/report.html` (self-contained) and each image as EXR beside it, and fail when an error
 //! exceeds its threshold in `validate/thresholds.json`.
 
+mod banding_stage;
 mod composite_stage;
 mod gpu_stages;
 mod readme;
@@ -199,7 +200,7 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
     let gpu = crate::lavapipe::open_gpu(args.adapter.as_deref())?;
     outln!("GPU: {}", gpu.describe());
     let thresholds = load_thresholds(args.thresholds.as_deref())?;
-    let mut stages = Stages { total: 10, done: 0, start: Instant::now() };
+    let mut stages = Stages { total: 10 + usize::from(plan.interleaved), done: 0, start: Instant::now() };
     stages.next("load environment map");
     let map = load_map(args.envmap.as_deref())?;
     let map_name = args.envmap.as_ref().map_or_else(
@@ -277,6 +278,13 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
 
     stages.next("compositing: a sphere into ar_ground's photograph, against the truth and Debevec's method");
     let compositing = composite_stage::run(&gpu, args.quick)?;
+
+    let banding = if plan.interleaved {
+        stages.next("banding: a wall under this run's lights, one light set and interleaved sets, against the map");
+        Some(banding_stage::run(&gpu, &map, &decomposition, plan.size, plan.shadow.resolution, plan.gpu_supersample)?)
+    } else {
+        None
+    };
 
     stages.next("metrics");
     let tm = FlipTonemap::for_reference(&reference.color);
@@ -360,6 +368,7 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
         method: &args.method,
         extract_ms: decomposition.time_ms,
         compositing: &compositing,
+        banding: banding.as_ref(),
     };
     let path = args.out.join("report.html");
     std::fs::write(&path, report.html(&args.out)?).map_err(|e| format!("{}: {e}", path.display()))?;
@@ -390,6 +399,9 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
             r.triangles,
             r.disagreement * 100.0
         );
+    }
+    for line in banding.iter().flat_map(banding_stage::BandingStage::lines) {
+        outln!("{line}");
     }
     outln!("report: {}", path.display());
     let figures = readme::Figures {

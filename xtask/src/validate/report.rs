@@ -28,6 +28,8 @@ pub(super) struct Report<'a> {
     pub(super) extract_ms: f64,
     pub(super) method: &'a str,
     pub(super) compositing: &'a super::composite_stage::Compositing,
+    /// The banding stage (`--interleaved`).
+    pub(super) banding: Option<&'a super::banding_stage::BandingStage>,
 }
 
 /// Relative luminance error as an 8-bit heat map (black 0, red 25 %, yellow 50 %, white ≥ 75 %).
@@ -202,6 +204,9 @@ impl Report<'_> {
         }
         s.push_str("</div>");
         s.push_str(&self.compositing.html(&|name, size, bytes| self.png(dir, name, size, bytes))?);
+        if let Some(banding) = self.banding {
+            s.push_str(&banding.html(&|name, size, bytes| self.png(dir, name, size, bytes))?);
+        }
         s.push_str("</body></html>\n");
         Ok(s)
     }
