@@ -98,6 +98,29 @@ impl BandingCase {
     pub fn truth(&self) -> &[Option<f64>] {
         &self.truth
     }
+
+    /// (column, luminance) of the truth, or of `image`'s mean down each column, over the
+    /// measured columns: the profiles [`ref_tracer::metrics::banding`] compares, unfiltered.
+    #[must_use]
+    pub fn profile(&self, image: Option<&[Vec3]>) -> Vec<(f64, f64)> {
+        let w = self.truth.len();
+        let rows = image.map_or(0, |i| i.len() / w.max(1));
+        self.truth
+            .iter()
+            .enumerate()
+            .filter_map(|(x, t)| {
+                let t = (*t)?;
+                let v = match image {
+                    Some(img) if rows > 0 => {
+                        (0..rows).map(|y| f64::from(envmap_sphere::color::luminance(img[y * w + x]))).sum::<f64>()
+                            / rows as f64
+                    }
+                    _ => t,
+                };
+                Some((x as f64, v))
+            })
+            .collect()
+    }
 }
 
 /// The wall facing `toward` (a unit direction above the horizon), the ground, and a camera

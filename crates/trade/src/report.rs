@@ -92,6 +92,60 @@ pub fn plot_svg(title: &str, points: &[Point], error_axis: &str) -> Result<Strin
 
 /// Tick values 1, 2, 5 x 10^n within `range`, or every 1..9 x 10^n where that gives fewer than
 /// three (a log axis over less than a decade otherwise gets one label).
+/// An SVG line plot of profiles across an image (`series`: name and (column, value) points;
+/// the first drawn black and thick, as the truth), `y_axis` naming the values.
+///
+/// # Errors
+/// [`TradeError::Plot`] when plotters fails or no series has a finite point.
+pub fn profile_svg(title: &str, series: &[(String, Vec<(f64, f64)>)], y_axis: &str) -> Result<String, TradeError> {
+    let plot_err = |e: &dyn std::fmt::Display| TradeError::Plot(format!("{title}: {e}"));
+    let points = || series.iter().flat_map(|s| s.1.iter()).filter(|p| p.0.is_finite() && p.1.is_finite());
+    let (x0, x1, y1) =
+        points().fold((f64::INFINITY, f64::NEG_INFINITY, 0.0f64), |(a, b, c), p| (a.min(p.0), b.max(p.0), c.max(p.1)));
+    if x0 > x1 {
+        return Err(plot_err(&"no finite point"));
+    }
+    let colours = [RGBColor(214, 39, 40), RGBColor(31, 119, 180), RGBColor(44, 160, 44), RGBColor(255, 127, 14)];
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (760, 400)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| plot_err(&e))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 18))
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(64)
+            .build_cartesian_2d(x0..x1.max(x0 + 1.0), 0.0..(y1 * 1.1).max(1e-12))
+            .map_err(|e| plot_err(&e))?;
+        chart
+            .configure_mesh()
+            .x_desc("column")
+            .y_desc(y_axis)
+            .max_light_lines(2)
+            .y_label_formatter(&|y| short_number(*y))
+            .draw()
+            .map_err(|e| plot_err(&e))?;
+        for (k, (name, pts)) in series.iter().enumerate() {
+            let style = if k == 0 { BLACK.stroke_width(3) } else { colours[(k - 1) % colours.len()].stroke_width(1) };
+            let finite: Vec<(f64, f64)> = pts.iter().copied().filter(|p| p.0.is_finite() && p.1.is_finite()).collect();
+            chart
+                .draw_series(LineSeries::new(finite, style))
+                .map_err(|e| plot_err(&e))?
+                .label(name.as_str())
+                .legend(move |(x, y)| PathElement::new([(x, y), (x + 16, y)], style));
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::LowerRight)
+            .draw()
+            .map_err(|e| plot_err(&e))?;
+        root.present().map_err(|e| plot_err(&e))?;
+    }
+    Ok(svg)
+}
+
 fn key_points(range: &std::ops::Range<f64>) -> Vec<f64> {
     let ticks = |mantissas: &[f64]| {
         let (lo, hi) = (range.start.max(f64::MIN_POSITIVE), range.end);

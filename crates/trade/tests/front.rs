@@ -290,3 +290,14 @@ fn families_keep_their_own_fronts_choices_and_report_sections() {
     assert_eq!(html.matches("<svg").count(), 11);
     assert!(html.contains(Family::Composite.error_axis()));
 }
+
+#[test]
+fn profile_plots_draw_every_series_and_refuse_nothing_to_draw() {
+    let ramp: Vec<(f64, f64)> = (0..40).map(|x| (f64::from(x), f64::from(x) / 40.0)).collect();
+    let stairs: Vec<(f64, f64)> = ramp.iter().map(|&(x, y)| (x, (y * 4.0).floor() / 4.0)).collect();
+    let svg = trade::report::profile_svg("steps", &[("truth".into(), ramp), ("one set".into(), stairs)], "luminance")
+        .expect("a plot");
+    assert!(svg.starts_with("<svg") && svg.contains("truth") && svg.contains("one set"), "{svg}");
+    let nothing = [("truth".to_string(), vec![(f64::NAN, 1.0)])];
+    assert!(trade::report::profile_svg("empty", &nothing, "luminance").is_err());
+}

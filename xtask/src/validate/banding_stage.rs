@@ -116,7 +116,19 @@ impl BandingStage {
             }
             let _ = write!(s, "<td>{:.1}</td><td>{:.1}</td></tr>", r.shadow_ms, r.frame_ms);
         }
-        s.push_str("</table><div class=\"grid\">");
+        s.push_str("</table>");
+        // one plot per technique: the truth and each light-set setting
+        let mut techniques: Vec<&str> = self.rows.iter().map(|r| r.technique.as_str()).collect();
+        techniques.dedup();
+        for technique in techniques {
+            let mut series = vec![("truth (the map)".to_string(), self.case.profile(None))];
+            for r in self.rows.iter().filter(|r| r.technique == technique) {
+                series.push((format!("{} sets", r.interleave.name()), self.case.profile(Some(&r.image))));
+            }
+            let title = format!("{technique}: luminance across the wall's shadow (mean down each column)");
+            s.push_str(&trade::report::profile_svg(&title, &series, "luminance").map_err(|e| e.to_string())?);
+        }
+        s.push_str("<div class=\"grid\">");
         let tonemap = Tonemap::auto(self.rows.first().map_or(&[][..], |r| &r.image[..]));
         for r in &self.rows {
             let name = format!("banding_{}_{}", r.technique, r.interleave.name().replace(" x ", "x"));
