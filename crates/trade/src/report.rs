@@ -34,11 +34,7 @@ pub fn plot_svg(title: &str, points: &[Point], error_axis: &str) -> Result<Strin
     {
         let root = SVGBackend::with_string(&mut svg, (760, 480)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| plot_err(&e))?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 18))
-            .margin(12)
-            .x_label_area_size(40)
-            .y_label_area_size(64)
+        let mut chart = builder(&root, title)
             .build_cartesian_2d(xr.clone().log_scale().with_key_points(key_points(&xr)), yr)
             .map_err(|e| plot_err(&e))?;
         chart
@@ -110,11 +106,7 @@ pub fn profile_svg(title: &str, series: &[(String, Vec<(f64, f64)>)], y_axis: &s
     {
         let root = SVGBackend::with_string(&mut svg, (760, 400)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| plot_err(&e))?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 18))
-            .margin(12)
-            .x_label_area_size(40)
-            .y_label_area_size(64)
+        let mut chart = builder(&root, title)
             .build_cartesian_2d(x0..x1.max(x0 + 1.0), 0.0..(y1 * 1.1).max(1e-12))
             .map_err(|e| plot_err(&e))?;
         chart
@@ -144,6 +136,16 @@ pub fn profile_svg(title: &str, series: &[(String, Vec<(f64, f64)>)], y_axis: &s
         root.present().map_err(|e| plot_err(&e))?;
     }
     Ok(svg)
+}
+
+/// The plots' common frame: title, margin, axis label areas.
+fn builder<'a, 'b, DB: DrawingBackend>(
+    root: &'a DrawingArea<DB, plotters::coord::Shift>,
+    title: &'b str,
+) -> ChartBuilder<'a, 'b, DB> {
+    let mut b = ChartBuilder::on(root);
+    b.caption(title, ("sans-serif", 18)).margin(12).x_label_area_size(40).y_label_area_size(64);
+    b
 }
 
 fn key_points(range: &std::ops::Range<f64>) -> Vec<f64> {
