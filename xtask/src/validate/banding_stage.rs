@@ -123,7 +123,9 @@ impl BandingStage {
         for technique in techniques {
             let mut series = vec![("truth (the map)".to_string(), self.case.profile(None))];
             for r in self.rows.iter().filter(|r| r.technique == technique) {
-                series.push((format!("{} sets", r.interleave.name()), self.case.profile(Some(&r.image))));
+                let label =
+                    if r.interleave.sets > 1 { format!("{} sets", r.interleave.name()) } else { "one set".into() };
+                series.push((label, self.case.profile(Some(&r.image))));
             }
             let title = format!("{technique}: luminance across the wall's shadow (mean down each column)");
             s.push_str(&trade::report::profile_svg(&title, &series, "luminance").map_err(|e| e.to_string())?);
