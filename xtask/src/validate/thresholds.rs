@@ -134,6 +134,29 @@ mod tests {
         assert!(f.is_empty() && checked == 0, "{f:?}");
     }
 
+    /// Another method's run (`scene@map[method]`) measures the same rows as the default's, so
+    /// each must limit the same rows, or `validate --method` fails on a row nobody limited.
+    #[test]
+    fn every_method_limits_the_rows_of_the_default_run() {
+        let t = parse_thresholds(THRESHOLDS, "validate/thresholds.json").unwrap_or_else(|e| panic!("{e}"));
+        let mut rows: BTreeMap<&str, BTreeSet<&str>> = BTreeMap::new();
+        for k in t.limits.keys() {
+            let (run, row) = key_parts(k);
+            rows.entry(run).or_default().insert(row);
+        }
+        let mut compared = 0;
+        for (run, set) in &rows {
+            let Some((head, rest)) = run.split_once('[') else { continue };
+            let Some((_, tail)) = rest.split_once(']') else { panic!("{run}: an unclosed method") };
+            let default = format!("{head}{tail}");
+            if let Some(default_rows) = rows.get(default.as_str()) {
+                assert_eq!(set, default_rows, "{run} against {default}");
+                compared += 1;
+            }
+        }
+        assert!(compared > 0, "no method's run to compare");
+    }
+
     #[test]
     fn a_key_both_limited_and_report_only_is_refused() {
         let text = r#"{"thresholds": {"s@m:a.rmse": 0.1}, "report_only": ["a"]}"#;
