@@ -14,6 +14,7 @@ macro_rules! outln {
 mod composite;
 mod eval_lights;
 mod extract;
+mod frame;
 mod fuzz;
 mod info;
 mod lavapipe;
@@ -130,6 +131,29 @@ enum Command {
         #[arg(long, default_value = "target/soft-shadows")]
         out: PathBuf,
     },
+    /// Paper 001's whole frame on the GPU, timed: G-buffer, the EnvDirects' wedges, the
+    /// EnvIndirects' maps at 1, 1/2 and 1/4 resolution, joint bilateral upsampling, shading; the
+    /// median and fastest ms per frame (and fps) of each.
+    Frame {
+        /// Built-in scene (`gallery`: 161,794 triangles, paper 001's scale).
+        #[arg(long, default_value = "gallery")]
+        scene: String,
+        /// Image size WIDTHxHEIGHT.
+        #[arg(long, value_parser = parse_size, default_value = "1600x1200")]
+        size: (u32, u32),
+        /// Frames timed per resolution, after an untimed one.
+        #[arg(long, default_value_t = 20)]
+        repeats: usize,
+        /// Lights K of the decomposition.
+        #[arg(long, default_value_t = 32)]
+        lights: usize,
+        /// Environment map (.exr or .hdr); the embedded default map when absent.
+        #[arg(long)]
+        envmap: Option<PathBuf>,
+        /// The GPU adapter: a case-insensitive part of its name, or `cpu`.
+        #[arg(long)]
+        adapter: Option<String>,
+    },
     /// Paper 003's shaft hierarchy on a built-in real scene (ar_room, ar_ground): radiosity
     /// solve, pre-processing (source set, receivers, transfers, shafts), the brute-force
     /// conservativeness check along a built-in object path, per-frame traversal time, and
@@ -219,6 +243,14 @@ fn main() -> ExitCode {
         Command::SoftShadows { scenes, size, adapter, out } => {
             soft_shadows::run(&scenes, size, adapter.as_deref(), &out)
         }
+        Command::Frame { scene, size, repeats, lights, envmap, adapter } => frame::run(&frame::FrameArgs {
+            scene: &scene,
+            size,
+            repeats,
+            lights,
+            envmap: envmap.as_deref(),
+            adapter: adapter.as_deref(),
+        }),
         Command::Scene { name, obj } => scene::run(&name, &obj),
         Command::Render(args) => render::run(&args),
         Command::Compare { reference, test } => render::compare(&reference, &test),

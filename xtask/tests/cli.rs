@@ -180,6 +180,28 @@ fn validate_refuses_an_unknown_scene_in_one_line() {
 }
 
 #[test]
+fn frame_times_each_resolution_and_refuses_bad_arguments_in_one_line() {
+    let out = xtask(&["frame", "--scene", "three_boxes", "--size", "64x48", "--repeats", "2", "--lights", "4"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
+    assert!(text.contains("three_boxes: 38 triangles, 64x48; 4 lights"), "{text}");
+    for name in ["full", "half", "quarter"] {
+        let line = text.lines().find(|l| l.contains(&format!("EnvIndirects at {name} resolution"))).expect(name);
+        assert!(line.contains(" fps)") && line.contains("over 2 frames"), "{line}");
+    }
+    for (args, says) in [
+        (&["frame", "--repeats", "0"][..], "--repeats 0"),
+        (&["frame", "--scene", "nowhere", "--size", "64x48"][..], "nowhere"),
+        (&["frame", "--envmap", "missing.exr", "--size", "64x48"][..], "missing.exr"),
+    ] {
+        let out = xtask(args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.trim().lines().count() == 1 && err.contains(says), "{args:?}: {err}");
+    }
+}
+
+#[test]
 fn scene_writes_obj_and_refuses_unknown_names() {
     let dir = fresh_dir("cli-scene");
     let obj = dir.join("spheres_box.obj");
