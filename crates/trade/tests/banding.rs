@@ -99,3 +99,38 @@ fn black_and_below_horizon_maps_refuse_with_a_reason() {
     assert!(BandingCase::new(&cap, &d, (4, 1)).is_err(), "too small an image");
     assert!(BandingCase::new(&cap, &d, (16, 2)).is_ok());
 }
+
+/// A small sun of `radiance` at `elevation` degrees over a dim sky.
+fn sun_map(elevation: f32, radiance: f32) -> EnvMap {
+    let (s, c) = elevation.to_radians().sin_cos();
+    let sun = Vec3::new(c, s, 0.0);
+    EnvMap::from_fn(128, 64, move |d| {
+        if d.dot(sun) > 3f32.to_radians().cos() {
+            Vec3::splat(radiance)
+        } else if d.y > 0.0 {
+            Vec3::splat(0.3)
+        } else {
+            Vec3::ZERO
+        }
+    })
+}
+
+#[test]
+fn extreme_suns_give_finite_cases_and_figures() {
+    let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
+    let passes = Passes::new(&gpu).expect("passes");
+    // an f16-max sun, a sun at the zenith (the wall's height clamps), a sun grazing the horizon
+    for (elevation, radiance) in [(40.0, 65504.0), (90.0, 100.0), (5.0, 100.0)] {
+        let case = case_of(&sun_map(elevation, radiance), 4, (48, 8));
+        let what = format!("sun at {elevation}° of {radiance}");
+        assert!(case.columns() > 30, "{what}: {} columns", case.columns());
+        assert!(case.truth().iter().flatten().all(|t| t.is_finite() && *t >= 0.0), "{what}");
+        let r = measure_banding(&gpu, &passes, &case, &Shadow::Maps { resolution: 256, pcf: 1 }, Interleave::PAPER, 1)
+            .expect("a frame");
+        assert!(r.image.iter().all(|p| p.is_finite()), "{what}: a non-finite pixel");
+        if let Some(b) = r.banding {
+            let figures = [b.contrast, b.largest_step, b.truth_largest_step, b.profile_error, b.noise];
+            assert!(figures.iter().all(|f| f.is_finite() && *f >= 0.0), "{what}: {b:?}");
+        }
+    }
+}
