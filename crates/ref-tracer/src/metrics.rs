@@ -135,6 +135,24 @@ pub struct Banding {
     pub noise: f64,
 }
 
+/// The mean luminance down each of `image`'s `width` columns (row-major): the profile across
+/// edges that run down the columns, as [`banding`] takes it.
+///
+/// # Panics
+/// When `image` is not `width` columns by whole rows.
+#[must_use]
+pub fn column_means(image: &[Vec3], width: usize) -> Vec<f64> {
+    assert!(width > 0 && image.len().is_multiple_of(width), "image is not {width} columns wide");
+    let rows = (image.len() / width).max(1) as f64;
+    let mut sums = vec![0.0; width];
+    for row in image.chunks_exact(width) {
+        for (s, p) in sums.iter_mut().zip(row) {
+            *s += f64::from(envmap_sphere::color::luminance(*p));
+        }
+    }
+    sums.into_iter().map(|s| s / rows).collect()
+}
+
 /// Columns on either side within which a jump of the truth excuses one of the image's: an edge
 /// drawn up to this far from the truth's is not counted as a band.
 pub const BANDING_WINDOW: usize = 2;
@@ -152,13 +170,9 @@ pub fn banding(image: &[Vec3], width: usize, truth: &[Option<f64>], weber: f64, 
     let scale = scale.max(1);
     let rows = image.len() / width;
     let luminance = |x: usize, y: usize| f64::from(envmap_sphere::color::luminance(image[y * width + x]));
-    let columns: Vec<Option<(f64, f64)>> = (0..width)
-        .map(|x| {
-            let t = truth[x].filter(|t| t.is_finite())?;
-            let mean = (0..rows).map(|y| luminance(x, y)).sum::<f64>() / rows.max(1) as f64;
-            Some((mean, t))
-        })
-        .collect();
+    let means = column_means(image, width);
+    let columns: Vec<Option<(f64, f64)>> =
+        (0..width).map(|x| truth[x].filter(|t| t.is_finite()).map(|t| (means[x], t))).collect();
     // (image, truth) box-filtered over columns x..x + scale, where all are measured
     let filtered: Vec<Option<(f64, f64)>> = (0..width)
         .map(|x| {

@@ -15,13 +15,13 @@ use crate::setting::Shadow;
 use envmap_sphere::EnvMap;
 use glam::{DVec3, Vec3};
 use gpu::{
-    Gpu, InterleavedFrame, LightShape, Receivers, RotatedGrid, SceneGeometry, ShadeLight, ShadeParams, Visibility,
-    WEBER_FRACTION, render_interleaved, render_visibility,
+    Gpu, InterleavedFrame, Receivers, RotatedGrid, SceneGeometry, ShadeLight, ShadeParams, Visibility, WEBER_FRACTION,
+    render_interleaved,
 };
 use light_extract::Decomposition;
 use rayon::prelude::*;
 use ref_tracer::SceneBvh;
-use ref_tracer::metrics::{Banding, banding};
+use ref_tracer::metrics::{Banding, banding, column_means};
 use scene::{Camera, DistantLight, Material, Mesh, Object, Scene};
 use std::time::Instant;
 
@@ -104,22 +104,11 @@ impl BandingCase {
     /// measured columns: the profiles [`ref_tracer::metrics::banding`] compares, unfiltered.
     #[must_use]
     pub fn profile(&self, image: Option<&[Vec3]>) -> Vec<(f64, f64)> {
-        let w = self.truth.len();
-        let rows = image.map_or(0, |i| i.len() / w.max(1));
+        let means = image.map(|i| column_means(i, self.truth.len()));
         self.truth
             .iter()
             .enumerate()
-            .filter_map(|(x, t)| {
-                let t = (*t)?;
-                let v = match image {
-                    Some(img) if rows > 0 => {
-                        (0..rows).map(|y| f64::from(envmap_sphere::color::luminance(img[y * w + x]))).sum::<f64>()
-                            / rows as f64
-                    }
-                    _ => t,
-                };
-                Some((x as f64, v))
-            })
+            .filter_map(|(x, t)| t.map(|t| (x as f64, means.as_ref().map_or(t, |m| m[x]))))
             .collect()
     }
 }
@@ -320,12 +309,7 @@ pub fn measure_banding(
             let vis = Visibility::new(gpu, w, h, lights.len().max(1) as u32)?;
             (passes.shading.render_texture(gpu, &geometry, &gb, &params, &vis)?, Vec::new())
         }
-        Some(technique) if sets == 1 => {
-            let shapes: Vec<LightShape> = light_sets[0].iter().map(LightShape::from).collect();
-            let vis = Visibility::new(gpu, w, h, lights.len().max(1) as u32)?;
-            let reports = render_visibility(gpu, technique, &receivers, &shapes, &[], &vis)?;
-            (passes.shading.render_texture(gpu, &geometry, &gb, &params, &vis)?, reports)
-        }
+        // one set too: its gathering is a copy, and every row takes the same path
         Some(technique) => {
             let frame =
                 InterleavedFrame { geometry: &geometry, receivers: &receivers, params: &params, negligible: &[] };
