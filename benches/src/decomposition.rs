@@ -18,10 +18,41 @@ use std::time::{Duration, Instant};
 /// The extraction the frame draws: the toolkit's most accurate (validate's default).
 pub const METHOD: &str = "emissive-split+moment-cones+above-horizon+residual";
 
+/// The EnvIndirects' maps: 1024², 3 x 3 PCF.
+fn maps_settings() -> ShadowSettings {
+    ShadowSettings { resolution: 1024, pcf_radius: 1, ..ShadowSettings::default() }
+}
+
+/// The object `cargo xtask frame --animate` moves: the scene's first object that is not its
+/// ground (moving a ground plane along itself changes nothing to see), else the first.
+#[must_use]
+pub fn animated_object(scene: &scene::Scene) -> usize {
+    scene.objects.iter().position(|o| o.name != "ground").unwrap_or(0)
+}
+
+/// Where the animated object is at frame `k`: on a horizontal circle through its rest pose,
+/// of a quarter of its bounding radius, a new pose every frame (64 poses a turn).
+#[must_use]
+pub fn animation_offset(scene: &scene::Scene, object: usize, k: usize) -> glam::Vec3 {
+    let Some(o) = scene.objects.get(object) else { return glam::Vec3::ZERO };
+    let (lo, hi) = o
+        .mesh
+        .positions
+        .iter()
+        .fold((glam::Vec3::splat(f32::INFINITY), glam::Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| {
+            (lo.min(*p), hi.max(*p))
+        });
+    let r = if lo.is_finite() { 0.125 * (hi - lo).length() } else { 0.0 };
+    let a = std::f32::consts::TAU * (k % 64) as f32 / 64.0;
+    glam::Vec3::new(r * (a.cos() - 1.0), 0.0, r * a.sin())
+}
+
 /// Everything a frame needs that does not change between frames.
 pub struct Frame {
-    /// The scene, its camera at the frame's size.
+    /// The scene, its camera at the frame's size (objects at their current poses).
     pub scene: scene::Scene,
+    /// The scene as built, before any object moved.
+    rest: scene::Scene,
     /// The decomposition of the default map, EnvDirects first.
     pub decomposition: Decomposition,
     geometry: SceneGeometry,
@@ -46,7 +77,6 @@ impl Frame {
         let extractor = light_extract::extractor(METHOD, lights).ok_or("unknown method")?;
         let mut decomposition = extractor.extract(map).map_err(|e| e.to_string())?;
         decomposition.sort_directs_first();
-        let maps_settings = ShadowSettings { resolution: 1024, pcf_radius: 1, ..ShadowSettings::default() };
         Ok(Self {
             geometry: SceneGeometry::upload(gpu, &scene).map_err(e)?,
             gbuffer: GBufferPass::new(gpu),
@@ -55,10 +85,31 @@ impl Frame {
             background: Background::upload(gpu, map).map_err(e)?,
             specular: SpecularAmbient::new(gpu, &decomposition.ambient, &PrefilterSettings::default()).map_err(e)?,
             wedges: Wedges::new(gpu, &scene, WedgeSettings::default()),
-            maps: MapTechnique::new(gpu, &scene, Technique::Orthographic, maps_settings, 1).map_err(e)?,
+            maps: MapTechnique::new(gpu, &scene, Technique::Orthographic, maps_settings(), 1).map_err(e)?,
+            rest: scene.clone(),
             scene,
             decomposition,
         })
+    }
+
+    /// Moves object `object` to its rest pose translated by `offset`: the techniques are built
+    /// afresh for the new pose (geometry uploaded again, casters welded again, pipelines created
+    /// again).
+    ///
+    /// # Errors
+    /// An object index out of range; GPU failures.
+    pub fn move_object(&mut self, gpu: &Gpu, object: usize, offset: glam::Vec3) -> Result<(), GpuError> {
+        let rest = self.rest.objects.get(object).ok_or_else(|| GpuError::Failed(format!("no object {object}")))?;
+        let moved = rest.mesh.positions.iter().map(|p| *p + offset).collect();
+        self.scene.objects[object].mesh.positions = moved;
+        self.geometry = SceneGeometry::upload(gpu, &self.scene)?;
+        self.wedges = Wedges::new(gpu, &self.scene, WedgeSettings::default());
+        self.maps = self.maps_for(gpu)?;
+        Ok(())
+    }
+
+    fn maps_for(&self, gpu: &Gpu) -> Result<MapTechnique, GpuError> {
+        MapTechnique::new(gpu, &self.scene, Technique::Orthographic, maps_settings(), 1)
     }
 
     /// Renders one frame with the EnvIndirects at 1 / `scale` and returns its wall time (GPU

@@ -3,6 +3,7 @@
 //! every bench once so none rots. This library holds the inputs benches share.
 
 pub mod decomposition;
+pub mod frame_stats;
 pub mod soft_shadows;
 
 use envmap_sphere::EnvMap;

@@ -2,9 +2,12 @@
 //! frame, `envshadow_benches::decomposition`, as one command a machine without Rust can run
 //! from a copied binary): G-buffer, the EnvDirects' wedges at full resolution, the
 //! EnvIndirects' 1024² orthographic maps at 1, 1/2 and 1/4 of it, joint bilateral upsampling,
-//! shading with the residual's SH9 and split-sum ambient.
+//! shading with the residual's SH9 and split-sum ambient. `--json` measures one scale and
+//! prints what each frame cost (`envshadow_benches::frame_stats`); `--animate` moves an object
+//! every frame.
 
-use envshadow_benches::decomposition::Frame;
+use envshadow_benches::decomposition::{Frame, animated_object, animation_offset};
+use envshadow_benches::frame_stats::{FrameStats, measure_frames};
 use std::path::Path;
 
 /// The most frames timed per scale: a typo should not hold a GPU machine for hours.
@@ -18,44 +21,88 @@ pub struct FrameArgs<'a> {
     pub lights: usize,
     pub envmap: Option<&'a Path>,
     pub adapter: Option<&'a str>,
+    pub animate: bool,
+    pub json: bool,
+    /// The EnvIndirects' scale `--json` measures.
+    pub scale: u32,
 }
 
-/// Times `repeats` frames per scale after one untimed frame (pipelines compile and buffers grow
-/// on it) and prints the median and the fastest, in ms and frames per second.
+/// Measures `repeats` frames per scale after one unmeasured frame (pipelines compile and
+/// buffers grow on it) and prints medians: per scale as text, or one scale as JSON.
 pub fn run(args: &FrameArgs) -> Result<(), String> {
     if args.repeats == 0 || args.repeats > MAX_REPEATS {
         return Err(format!("--repeats {}: give 1 to {MAX_REPEATS}", args.repeats));
     }
+    if !matches!(args.scale, 1 | 2 | 4) {
+        return Err(format!("--scale {}: give 1, 2 or 4", args.scale));
+    }
     let gpu = crate::lavapipe::open_gpu(args.adapter)?;
-    outln!("GPU: {}", gpu.describe());
+    if !args.json {
+        outln!("GPU: {}", gpu.describe());
+    }
     let map = crate::render::load_map(args.envmap)?;
-    let frame = Frame::new(&gpu, args.scene, args.size, &map, args.lights)?;
+    let mut frame = Frame::new(&gpu, args.scene, args.size, &map, args.lights)?;
+    let moving = args.animate.then(|| animated_object(&frame.scene));
+    let rest = frame.scene.clone();
     let d = &frame.decomposition;
-    outln!(
-        "{}: {} triangles, {}x{}; {} lights ({}): {} EnvDirects with wedges, {} EnvIndirects with 1024² maps",
-        args.scene,
-        frame.scene.triangle_count(),
-        args.size.0,
-        args.size.1,
-        d.lights.len(),
-        envshadow_benches::decomposition::METHOD,
-        d.directs(),
-        d.lights.len() - d.directs()
-    );
-    for (name, scale) in [("full", 1), ("half", 2), ("quarter", 4)] {
-        frame.render(&gpu, scale).map_err(|e| e.to_string())?;
-        let mut ms = (0..args.repeats)
-            .map(|_| frame.render(&gpu, scale).map(|(t, _)| t.as_secs_f64() * 1e3))
-            .collect::<Result<Vec<f64>, _>>()
-            .map_err(|e| e.to_string())?;
-        ms.sort_by(f64::total_cmp);
-        let median = ms[ms.len() / 2];
+    let (lights, directs) = (d.lights.len(), d.directs());
+    if !args.json {
         outln!(
-            "  EnvIndirects at {name} resolution: median {median:.2} ms ({:.1} fps), fastest {:.2} ms, over {} frames (wall time, the frame's CPU work and waits included)",
-            1e3 / median,
-            ms[0],
-            ms.len()
+            "{}: {} triangles, {}x{}; {lights} lights ({}): {directs} EnvDirects with wedges, {} EnvIndirects with 1024² maps{}",
+            args.scene,
+            frame.scene.triangle_count(),
+            args.size.0,
+            args.size.1,
+            envshadow_benches::decomposition::METHOD,
+            lights - directs,
+            moving.map_or(String::new(), |k| format!("; {} moving", frame.scene.objects[k].name))
         );
     }
+    let scales: &[(&str, u32)] =
+        if args.json { &[("", args.scale)] } else { &[("full", 1), ("half", 2), ("quarter", 4)] };
+    for &(name, scale) in scales {
+        let stats = measure_frames(&gpu, args.repeats, |k| -> Result<(), gpu::GpuError> {
+            if let Some(object) = moving {
+                frame.move_object(&gpu, object, animation_offset(&rest, object, k))?;
+            }
+            frame.render(&gpu, scale).map(|_| ())
+        })
+        .map_err(|e| e.to_string())?;
+        if args.json {
+            outln!("{}", json(args, &gpu, &stats, moving.map(|k| rest.objects[k].name.as_str()), lights));
+        } else {
+            outln!(
+                "  EnvIndirects at {name} resolution: median {:.2} ms ({:.1} fps) over {} frames; per frame {} submissions, {} waits, {} bytes read back, {:.2} ms CPU outside waits{}; {} pipelines created after the first frame",
+                stats.wall_ms,
+                1e3 / stats.wall_ms,
+                stats.frames,
+                stats.submits_per_frame,
+                stats.waits_per_frame,
+                stats.readback_bytes_per_frame,
+                stats.cpu_record_ms,
+                stats.gpu_ms.map_or(String::new(), |g| format!(", {g:.2} ms GPU (timestamps)")),
+                stats.pipelines_created_after_first_frame,
+            );
+        }
+    }
     Ok(())
+}
+
+fn json(args: &FrameArgs, gpu: &gpu::Gpu, s: &FrameStats, moving: Option<&str>, lights: usize) -> serde_json::Value {
+    serde_json::json!({
+        "scene": args.scene,
+        "size": [args.size.0, args.size.1],
+        "lights": lights,
+        "indirect_scale": args.scale,
+        "animated_object": moving,
+        "frames": s.frames,
+        "submits_per_frame": s.submits_per_frame,
+        "waits_per_frame": s.waits_per_frame,
+        "readback_bytes_per_frame": s.readback_bytes_per_frame,
+        "pipelines_created_after_first_frame": s.pipelines_created_after_first_frame,
+        "cpu_record_ms": s.cpu_record_ms,
+        "gpu_ms": s.gpu_ms,
+        "wall_ms": s.wall_ms,
+        "adapter": gpu.describe(),
+    })
 }

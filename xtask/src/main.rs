@@ -153,6 +153,17 @@ enum Command {
         /// The GPU adapter: a case-insensitive part of its name, or `cpu`.
         #[arg(long)]
         adapter: Option<String>,
+        /// Move the scene's first object other than its ground along a circle, a new pose
+        /// every frame.
+        #[arg(long)]
+        animate: bool,
+        /// One JSON object: what a frame costs at `--scale` (submissions, waits, bytes read
+        /// back, pipelines created after the first frame, CPU, GPU and wall ms; medians).
+        #[arg(long)]
+        json: bool,
+        /// With `--json`: the EnvIndirects at 1 / this of the resolution (1, 2 or 4).
+        #[arg(long, default_value_t = 2)]
+        scale: u32,
     },
     /// Paper 003's shaft hierarchy on a built-in real scene (ar_room, ar_ground): radiosity
     /// solve, pre-processing (source set, receivers, transfers, shafts), the brute-force
@@ -243,14 +254,19 @@ fn main() -> ExitCode {
         Command::SoftShadows { scenes, size, adapter, out } => {
             soft_shadows::run(&scenes, size, adapter.as_deref(), &out)
         }
-        Command::Frame { scene, size, repeats, lights, envmap, adapter } => frame::run(&frame::FrameArgs {
-            scene: &scene,
-            size,
-            repeats,
-            lights,
-            envmap: envmap.as_deref(),
-            adapter: adapter.as_deref(),
-        }),
+        Command::Frame { scene, size, repeats, lights, envmap, adapter, animate, json, scale } => {
+            frame::run(&frame::FrameArgs {
+                scene: &scene,
+                size,
+                repeats,
+                lights,
+                envmap: envmap.as_deref(),
+                adapter: adapter.as_deref(),
+                animate,
+                json,
+                scale,
+            })
+        }
         Command::Scene { name, obj } => scene::run(&name, &obj),
         Command::Render(args) => render::run(&args),
         Command::Compare { reference, test } => render::compare(&reference, &test),

@@ -180,6 +180,39 @@ fn validate_refuses_an_unknown_scene_in_one_line() {
 }
 
 #[test]
+fn frame_json_counts_what_a_moving_frame_costs() {
+    let out = xtask(&[
+        "frame",
+        "--scene",
+        "spheres_box",
+        "--size",
+        "64x48",
+        "--repeats",
+        "3",
+        "--lights",
+        "4",
+        "--animate",
+        "--json",
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_str(text.trim()).unwrap_or_else(|e| panic!("{e}: {text}"));
+    assert_eq!(v["frames"], 3, "{v}");
+    assert_eq!(v["animated_object"], "sphere", "{v}");
+    for k in ["submits_per_frame", "waits_per_frame", "readback_bytes_per_frame", "cpu_record_ms", "wall_ms"] {
+        assert!(v[k].as_f64().is_some_and(|x| x.is_finite() && x >= 0.0), "{k}: {v}");
+    }
+    // every frame is submitted and waited for at least once
+    assert!(v["submits_per_frame"].as_f64() >= Some(1.0) && v["waits_per_frame"].as_f64() >= Some(1.0), "{v}");
+    assert!(v["pipelines_created_after_first_frame"].as_u64().is_some(), "{v}");
+    assert!(v["gpu_ms"].is_null() || v["gpu_ms"].as_f64().is_some_and(|g| g >= 0.0), "{v}");
+    assert!(v["adapter"].as_str().is_some_and(|a| !a.is_empty()), "{v}");
+    let out = xtask(&["frame", "--json", "--scale", "3", "--size", "64x48"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--scale 3"));
+}
+
+#[test]
 fn frame_times_each_resolution_and_refuses_bad_arguments_in_one_line() {
     let out = xtask(&["frame", "--scene", "three_boxes", "--size", "64x48", "--repeats", "2", "--lights", "4"]);
     let text = String::from_utf8_lossy(&out.stdout);

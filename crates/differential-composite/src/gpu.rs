@@ -178,7 +178,7 @@ impl GpuCompositor {
         let module =
             |label: &str, src: &str| gpu::shader::module(&gpu.device, label, src, shadowmap_paraboloid::LIBRARY);
         let pipeline = |label: &str, m: &wgpu::ShaderModule| {
-            gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            gpu.compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(label),
                 layout: None,
                 module: m,

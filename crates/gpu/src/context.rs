@@ -3,6 +3,8 @@
 //! caller or by `ENVSHADOW_ADAPTER`, with the optional features our passes use when the adapter
 //! has them.
 
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 /// Errors of the GPU layer.
@@ -55,8 +57,48 @@ pub struct Gpu {
     pub info: wgpu::AdapterInfo,
     /// Features enabled on the device.
     pub features: wgpu::Features,
-    /// Limits of the device (the adapter's).
+    /// Limits of the device (the adapter's, or what the caller's device was created with).
     pub limits: wgpu::Limits,
+    counters: Arc<Counters>,
+}
+
+/// What the toolkit asked of the device since it was wrapped: submissions, CPU waits, bytes
+/// mapped back and pipelines created. A real-time frame is judged by these (`cargo xtask frame
+/// --json`): differences of two snapshots count one frame's.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct GpuCounters {
+    /// Command buffers submitted to the queue (one per `queue.submit` call).
+    pub submits: u64,
+    /// Times the CPU blocked on the device (a poll that waits).
+    pub waits: u64,
+    /// Bytes of buffers mapped for reading on the CPU.
+    pub readback_bytes: u64,
+    /// Render and compute pipelines created.
+    pub pipelines: u64,
+    /// Nanoseconds the CPU spent in those waits.
+    pub wait_ns: u64,
+}
+
+impl std::ops::Sub for GpuCounters {
+    type Output = GpuCounters;
+    fn sub(self, o: GpuCounters) -> GpuCounters {
+        GpuCounters {
+            submits: self.submits - o.submits,
+            waits: self.waits - o.waits,
+            readback_bytes: self.readback_bytes - o.readback_bytes,
+            pipelines: self.pipelines - o.pipelines,
+            wait_ns: self.wait_ns - o.wait_ns,
+        }
+    }
+}
+
+#[derive(Debug, Default)]
+struct Counters {
+    submits: AtomicU64,
+    waits: AtomicU64,
+    readback_bytes: AtomicU64,
+    pipelines: AtomicU64,
+    wait_ns: AtomicU64,
 }
 
 /// The environment variable [`Gpu::new`] reads an adapter name from (as `--adapter`).
@@ -190,7 +232,73 @@ impl Gpu {
             ..Default::default()
         }))
         .map_err(|e| GpuError::Device { adapter: info.name.clone(), reason: e.to_string() })?;
-        Ok(Self { device, queue, info, features, limits })
+        Ok(Self { device, queue, info, features, limits, counters: Arc::default() })
+    }
+
+    /// Wraps a device and queue the caller already has (a winit surface's, Bevy's
+    /// `RenderDevice`), with its adapter's `info`. The toolkit uses the features and limits the
+    /// device was created with: `CLIP_DISTANCES`, `FLOAT32_BLENDABLE` and timestamp queries are
+    /// used when enabled and done without otherwise; every technique runs within
+    /// `wgpu::Limits::default()`.
+    #[must_use]
+    pub fn from_device(device: wgpu::Device, queue: wgpu::Queue, info: wgpu::AdapterInfo) -> Self {
+        let features = device.features();
+        let limits = device.limits();
+        Self { device, queue, info, features, limits, counters: Arc::default() }
+    }
+
+    /// What the toolkit has asked of the device so far (see [`GpuCounters`]).
+    #[must_use]
+    pub fn counters(&self) -> GpuCounters {
+        let c = &self.counters;
+        GpuCounters {
+            submits: c.submits.load(Ordering::Relaxed),
+            waits: c.waits.load(Ordering::Relaxed),
+            readback_bytes: c.readback_bytes.load(Ordering::Relaxed),
+            pipelines: c.pipelines.load(Ordering::Relaxed),
+            wait_ns: c.wait_ns.load(Ordering::Relaxed),
+        }
+    }
+
+    /// Submits `encoder` without waiting.
+    pub fn submit(&self, encoder: wgpu::CommandEncoder) -> wgpu::SubmissionIndex {
+        self.counters.submits.fetch_add(1, Ordering::Relaxed);
+        self.queue.submit([encoder.finish()])
+    }
+
+    /// Blocks until the queue has finished `index` (or everything submitted, for `None`).
+    ///
+    /// # Errors
+    /// [`GpuError::Failed`] when the device is lost or the wait fails.
+    pub fn wait(&self, index: Option<wgpu::SubmissionIndex>) -> Result<(), GpuError> {
+        self.counters.waits.fetch_add(1, Ordering::Relaxed);
+        let start = Instant::now();
+        let r = self
+            .device
+            .poll(wgpu::PollType::Wait { submission_index: index, timeout: None })
+            .map(|_| ())
+            .map_err(|e| GpuError::Failed(e.to_string()));
+        self.counters.wait_ns.fetch_add(start.elapsed().as_nanos() as u64, Ordering::Relaxed);
+        r
+    }
+
+    /// Counts `bytes` mapped back to the CPU.
+    pub(crate) fn count_readback(&self, bytes: u64) {
+        self.counters.readback_bytes.fetch_add(bytes, Ordering::Relaxed);
+    }
+
+    /// Creates a render pipeline (counted in [`GpuCounters::pipelines`]).
+    #[must_use]
+    pub fn render_pipeline(&self, descriptor: &wgpu::RenderPipelineDescriptor) -> wgpu::RenderPipeline {
+        self.counters.pipelines.fetch_add(1, Ordering::Relaxed);
+        self.device.create_render_pipeline(descriptor)
+    }
+
+    /// Creates a compute pipeline (counted in [`GpuCounters::pipelines`]).
+    #[must_use]
+    pub fn compute_pipeline(&self, descriptor: &wgpu::ComputePipelineDescriptor) -> wgpu::ComputePipeline {
+        self.counters.pipelines.fetch_add(1, Ordering::Relaxed);
+        self.device.create_compute_pipeline(descriptor)
     }
 
     /// One line: adapter, backend, driver and its version.
@@ -230,11 +338,8 @@ impl Gpu {
     /// # Errors
     /// [`GpuError::Failed`] when the device is lost or the wait fails.
     pub fn submit_and_wait(&self, encoder: wgpu::CommandEncoder) -> Result<(), GpuError> {
-        let index = self.queue.submit([encoder.finish()]);
-        self.device
-            .poll(wgpu::PollType::Wait { submission_index: Some(index), timeout: None })
-            .map(|_| ())
-            .map_err(|e| GpuError::Failed(e.to_string()))
+        let index = self.submit(encoder);
+        self.wait(Some(index))
     }
 
     /// Wall time to submit `encoder` and wait for it: the time a frame's work takes end to end.

@@ -23,7 +23,7 @@ pub fn pipeline_with_target(
     module: &wgpu::ShaderModule,
     target: wgpu::ColorTargetState,
 ) -> wgpu::RenderPipeline {
-    gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+    gpu.render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
         layout: None,
         vertex: wgpu::VertexState {

@@ -75,7 +75,7 @@ impl GBufferPass {
         let module =
             crate::shader::module(&gpu.device, "gbuffer", include_str!("../../../shaders/gpu/gbuffer.wgsl"), &[]);
         let targets: [Option<wgpu::ColorTargetState>; 3] = std::array::from_fn(|_| Some(GBUFFER_FORMAT.into()));
-        let pipeline = gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        let pipeline = gpu.render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("gbuffer"),
             layout: None,
             vertex: wgpu::VertexState {

@@ -29,13 +29,13 @@ mod timer;
 mod upsample;
 
 pub use ambient::{DfgTable, PrefilterSettings, PrefilteredMap, SpecularAmbient};
-pub use context::{ADAPTER_ENV, Gpu, GpuError, adapters, describe_adapter, pick_adapter};
+pub use context::{ADAPTER_ENV, Gpu, GpuCounters, GpuError, adapters, describe_adapter, pick_adapter};
 pub use gbuffer::{
     GBUFFER_FORMAT, GBuffer, GBufferPass, view_projection, view_projection_infinite, view_projection_reverse,
 };
 pub use geometry::{Chunk, SceneGeometry, ShadowGeometry, scene_triangles};
 pub use interleave::{InterleavePass, InterleavedFrame, MAX_SETS, interleave_set, interleave_tile, render_interleaved};
-pub use readback::{read_buffer, read_texture_f32, read_texture_rgba};
+pub use readback::{read_buffer, read_mapped, read_texture_f32, read_texture_rgba};
 pub use shade::{Background, HDR_FORMAT, ShadeLight, ShadeParams, ShadingPass, Visibility, read_hdr};
 pub use split::{SplitFrame, SplitImage, SplitPasses, SplitSettings, render_split};
 pub use supersample::RotatedGrid;

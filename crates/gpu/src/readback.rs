@@ -8,13 +8,22 @@ pub(crate) fn map_read(gpu: &Gpu, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuE
     buffer.map_async(wgpu::MapMode::Read, .., move |r| {
         let _ = tx.send(r);
     });
-    gpu.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Failed(e.to_string()))?;
+    gpu.wait(None)?;
+    gpu.count_readback(buffer.size());
     rx.recv()
         .map_err(|e| GpuError::Failed(e.to_string()))?
         .map_err(|e| GpuError::Failed(format!("mapping a readback buffer: {e}")))?;
     let bytes = buffer.get_mapped_range(..).map_err(|e| GpuError::Failed(e.to_string()))?.to_vec();
     buffer.unmap();
     Ok(bytes)
+}
+
+/// Maps `buffer` (which needs `MAP_READ`, its work submitted) and returns its bytes: a wait.
+///
+/// # Errors
+/// [`GpuError::Failed`] when the wait or the mapping fails.
+pub fn read_mapped(gpu: &Gpu, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
+    map_read(gpu, buffer)
 }
 
 /// Copies `buffer` (which needs `COPY_SRC`) back to the CPU.

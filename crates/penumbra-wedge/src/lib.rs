@@ -228,7 +228,7 @@ impl Wedges {
         let volume_module = module("shadow volume", include_str!("../../../shaders/penumbra-wedge/volume.wgsl"));
         let wedge_module = module("wedges", include_str!("../../../shaders/penumbra-wedge/wedge.wgsl"));
         let pipeline = |label, m: &wgpu::ShaderModule, layout: wgpu::VertexBufferLayout<'_>| {
-            gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            gpu.render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(label),
                 layout: None,
                 vertex: wgpu::VertexState {
@@ -276,7 +276,7 @@ impl Wedges {
             LIBRARY,
         );
         let tiles_module = module("wedge tiles", include_str!("../../../shaders/penumbra-wedge/tiles.wgsl"));
-        let tiles = gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        let tiles = gpu.compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some("wedge tiles"),
             layout: None,
             module: &tiles_module,

@@ -172,7 +172,7 @@ fn depth_pipeline(
     fragment: bool,
 ) -> wgpu::RenderPipeline {
     let module = gpu::shader::module(&gpu.device, label, source, LIBRARY);
-    gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+    gpu.render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
         layout: Some(layout),
         vertex: wgpu::VertexState {

@@ -1,0 +1,148 @@
+//! What a frame costs, counted over many frames: queue submissions, CPU waits, bytes mapped
+//! back, pipelines created after the first frame (from `gpu::GpuCounters`), the CPU's time
+//! outside waits, GPU time between two timestamps around the frame, and wall time.
+//!
+//! The measurement wraps the frame: the timestamps go in submissions of their own before and
+//! after it, and their submissions, waits and readback are not counted as the frame's. The one
+//! wait it adds, for the frame's work to finish, is counted (a frame that already waited finds
+//! nothing left to wait for).
+
+use gpu::{Gpu, GpuCounters, GpuError};
+use std::time::{Duration, Instant};
+
+/// Medians per frame over the measured frames (the first, where pipelines compile and buffers
+/// grow, is rendered but not measured).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameStats {
+    /// Frames measured.
+    pub frames: usize,
+    /// Queue submissions.
+    pub submits_per_frame: f64,
+    /// Times the CPU blocked on the GPU.
+    pub waits_per_frame: f64,
+    /// Bytes mapped back to the CPU.
+    pub readback_bytes_per_frame: f64,
+    /// Pipelines created over all measured frames.
+    pub pipelines_created_after_first_frame: u64,
+    /// CPU time outside waits: recording, planning, uploads.
+    pub cpu_record_ms: f64,
+    /// GPU time from the frame's first command to its last (timestamps), `None` without
+    /// timestamp queries.
+    pub gpu_ms: Option<f64>,
+    /// Wall time until the frame's work is done.
+    pub wall_ms: f64,
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Two timestamps around a frame, when the device has them.
+struct Stamps {
+    set: wgpu::QuerySet,
+    resolve: wgpu::Buffer,
+    read: wgpu::Buffer,
+}
+
+impl Stamps {
+    fn new(gpu: &Gpu) -> Option<Self> {
+        let needed = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+        if !gpu.features.contains(needed) {
+            return None;
+        }
+        let set = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
+            label: Some("frame stamps"),
+            ty: wgpu::QueryType::Timestamp,
+            count: 2,
+        });
+        let buffer = |label, usage| {
+            gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: 16,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        Some(Self {
+            set,
+            resolve: buffer("frame stamps", wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC),
+            read: buffer("frame stamps read", wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST),
+        })
+    }
+
+    fn stamp(&self, gpu: &Gpu, k: u32) {
+        let mut encoder = gpu.encoder("frame stamp");
+        encoder.write_timestamp(&self.set, k);
+        if k == 1 {
+            encoder.resolve_query_set(&self.set, 0..2, &self.resolve, 0);
+            encoder.copy_buffer_to_buffer(&self.resolve, 0, &self.read, 0, 16);
+        }
+        gpu.submit(encoder);
+    }
+
+    fn read(&self, gpu: &Gpu) -> Result<f64, GpuError> {
+        let bytes = gpu::read_mapped(gpu, &self.read)?;
+        let ticks: [u64; 2] = bytemuck_ticks(&bytes);
+        Ok(ticks[1].saturating_sub(ticks[0]) as f64 * f64::from(gpu.queue.get_timestamp_period()) * 1e-6)
+    }
+}
+
+fn bytemuck_ticks(bytes: &[u8]) -> [u64; 2] {
+    let word = |k: usize| u64::from_le_bytes(bytes[8 * k..8 * k + 8].try_into().unwrap_or([0; 8]));
+    if bytes.len() < 16 { [0, 0] } else { [word(0), word(1)] }
+}
+
+/// Renders `frames + 1` frames with `frame` (given the frame's index; the first is not
+/// measured) and returns the medians.
+///
+/// # Errors
+/// The frame's errors; GPU failures.
+pub fn measure_frames<E: From<GpuError>>(
+    gpu: &Gpu,
+    frames: usize,
+    mut frame: impl FnMut(usize) -> Result<(), E>,
+) -> Result<FrameStats, E> {
+    let stamps = Stamps::new(gpu);
+    let (mut submits, mut waits, mut bytes, mut cpu, mut gpu_ms, mut wall) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut pipelines_after_first = 0;
+    for k in 0..=frames {
+        if let Some(s) = &stamps {
+            s.stamp(gpu, 0);
+        }
+        let before: GpuCounters = gpu.counters();
+        let start = Instant::now();
+        frame(k)?;
+        gpu.wait(None)?;
+        let elapsed = start.elapsed();
+        let d = gpu.counters() - before;
+        if let Some(s) = &stamps {
+            s.stamp(gpu, 1);
+        }
+        let ms = stamps.as_ref().map(|s| s.read(gpu)).transpose()?;
+        if k == 0 {
+            continue;
+        }
+        pipelines_after_first += d.pipelines;
+        submits.push(d.submits as f64);
+        waits.push(d.waits as f64);
+        bytes.push(d.readback_bytes as f64);
+        cpu.push(elapsed.saturating_sub(Duration::from_nanos(d.wait_ns)).as_secs_f64() * 1e3);
+        wall.push(elapsed.as_secs_f64() * 1e3);
+        gpu_ms.extend(ms);
+    }
+    Ok(FrameStats {
+        frames,
+        submits_per_frame: median(submits),
+        waits_per_frame: median(waits),
+        readback_bytes_per_frame: median(bytes),
+        pipelines_created_after_first_frame: pipelines_after_first,
+        cpu_record_ms: median(cpu),
+        gpu_ms: (!gpu_ms.is_empty()).then(|| median(gpu_ms)),
+        wall_ms: median(wall),
+    })
+}
