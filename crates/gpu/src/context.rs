@@ -79,15 +79,16 @@ pub struct GpuCounters {
     pub wait_ns: u64,
 }
 
+/// What happened between two snapshots, `later - earlier` (saturating: never negative).
 impl std::ops::Sub for GpuCounters {
     type Output = GpuCounters;
     fn sub(self, o: GpuCounters) -> GpuCounters {
         GpuCounters {
-            submits: self.submits - o.submits,
-            waits: self.waits - o.waits,
-            readback_bytes: self.readback_bytes - o.readback_bytes,
-            pipelines: self.pipelines - o.pipelines,
-            wait_ns: self.wait_ns - o.wait_ns,
+            submits: self.submits.saturating_sub(o.submits),
+            waits: self.waits.saturating_sub(o.waits),
+            readback_bytes: self.readback_bytes.saturating_sub(o.readback_bytes),
+            pipelines: self.pipelines.saturating_sub(o.pipelines),
+            wait_ns: self.wait_ns.saturating_sub(o.wait_ns),
         }
     }
 }
