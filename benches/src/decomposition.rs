@@ -31,7 +31,7 @@ pub fn animated_object(scene: &scene::Scene) -> usize {
 }
 
 /// Where the animated object is at frame `k`: on a horizontal circle through its rest pose,
-/// of a quarter of its bounding radius, a new pose every frame (64 poses a turn).
+/// of radius an eighth of its bounding box's diagonal, a new pose every frame (64 poses a turn).
 #[must_use]
 pub fn animation_offset(scene: &scene::Scene, object: usize, k: usize) -> glam::Vec3 {
     let Some(o) = scene.objects.get(object) else { return glam::Vec3::ZERO };
@@ -104,12 +104,14 @@ impl Frame {
         self.scene.objects[object].mesh.positions = moved;
         self.geometry = SceneGeometry::upload(gpu, &self.scene)?;
         self.wedges = Wedges::new(gpu, &self.scene, WedgeSettings::default());
-        self.maps = self.maps_for(gpu)?;
+        self.maps = MapTechnique::new(gpu, &self.scene, Technique::Orthographic, maps_settings(), 1)?;
         Ok(())
     }
 
-    fn maps_for(&self, gpu: &Gpu) -> Result<MapTechnique, GpuError> {
-        MapTechnique::new(gpu, &self.scene, Technique::Orthographic, maps_settings(), 1)
+    /// The scene as built, before any object moved ([`Frame::move_object`] offsets from it).
+    #[must_use]
+    pub fn rest(&self) -> &scene::Scene {
+        &self.rest
     }
 
     /// Renders one frame with the EnvIndirects at 1 / `scale` and returns its wall time (GPU

@@ -86,14 +86,9 @@ impl Stamps {
 
     fn read(&self, gpu: &Gpu) -> Result<f64, GpuError> {
         let bytes = gpu::read_mapped(gpu, &self.read)?;
-        let ticks: [u64; 2] = bytemuck_ticks(&bytes);
-        Ok(ticks[1].saturating_sub(ticks[0]) as f64 * f64::from(gpu.queue.get_timestamp_period()) * 1e-6)
+        let tick = |k: usize| bytes.get(8 * k..8 * k + 8).and_then(|b| b.try_into().ok()).map_or(0, u64::from_le_bytes);
+        Ok(tick(1).saturating_sub(tick(0)) as f64 * f64::from(gpu.queue.get_timestamp_period()) * 1e-6)
     }
-}
-
-fn bytemuck_ticks(bytes: &[u8]) -> [u64; 2] {
-    let word = |k: usize| u64::from_le_bytes(bytes[8 * k..8 * k + 8].try_into().unwrap_or([0; 8]));
-    if bytes.len() < 16 { [0, 0] } else { [word(0), word(1)] }
 }
 
 /// Renders `frames + 1` frames with `frame` (given the frame's index; the first is not

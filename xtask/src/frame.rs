@@ -43,7 +43,6 @@ pub fn run(args: &FrameArgs) -> Result<(), String> {
     let map = crate::render::load_map(args.envmap)?;
     let mut frame = Frame::new(&gpu, args.scene, args.size, &map, args.lights)?;
     let moving = args.animate.then(|| animated_object(&frame.scene));
-    let rest = frame.scene.clone();
     let d = &frame.decomposition;
     let (lights, directs) = (d.lights.len(), d.directs());
     if !args.json {
@@ -63,13 +62,14 @@ pub fn run(args: &FrameArgs) -> Result<(), String> {
     for &(name, scale) in scales {
         let stats = measure_frames(&gpu, args.repeats, |k| -> Result<(), gpu::GpuError> {
             if let Some(object) = moving {
-                frame.move_object(&gpu, object, animation_offset(&rest, object, k))?;
+                let offset = animation_offset(frame.rest(), object, k);
+                frame.move_object(&gpu, object, offset)?;
             }
             frame.render(&gpu, scale).map(|_| ())
         })
         .map_err(|e| e.to_string())?;
         if args.json {
-            outln!("{}", json(args, &gpu, &stats, moving.map(|k| rest.objects[k].name.as_str()), lights));
+            outln!("{}", json(args, &gpu, &stats, moving.map(|k| frame.rest().objects[k].name.as_str()), lights));
         } else {
             outln!(
                 "  EnvIndirects at {name} resolution: median {:.2} ms ({:.1} fps) over {} frames; per frame {} submissions, {} waits, {} bytes read back, {:.2} ms CPU outside waits{}; {} pipelines created after the first frame",

@@ -2,8 +2,11 @@
 
 use crate::context::{Gpu, GpuError};
 
-/// Maps `buffer` (MAP_READ) and returns its bytes.
-pub(crate) fn map_read(gpu: &Gpu, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
+/// Maps `buffer` (which needs `MAP_READ`, its work submitted) and returns its bytes: a wait.
+///
+/// # Errors
+/// [`GpuError::Failed`] when the wait or the mapping fails.
+pub fn read_mapped(gpu: &Gpu, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
     let (tx, rx) = std::sync::mpsc::channel();
     buffer.map_async(wgpu::MapMode::Read, .., move |r| {
         let _ = tx.send(r);
@@ -16,14 +19,6 @@ pub(crate) fn map_read(gpu: &Gpu, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuE
     let bytes = buffer.get_mapped_range(..).map_err(|e| GpuError::Failed(e.to_string()))?.to_vec();
     buffer.unmap();
     Ok(bytes)
-}
-
-/// Maps `buffer` (which needs `MAP_READ`, its work submitted) and returns its bytes: a wait.
-///
-/// # Errors
-/// [`GpuError::Failed`] when the wait or the mapping fails.
-pub fn read_mapped(gpu: &Gpu, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
-    map_read(gpu, buffer)
 }
 
 /// Copies `buffer` (which needs `COPY_SRC`) back to the CPU.
@@ -40,7 +35,7 @@ pub fn read_buffer(gpu: &Gpu, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError
     let mut encoder = gpu.encoder("readback");
     encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
     gpu.submit_and_wait(encoder)?;
-    map_read(gpu, &staging)
+    read_mapped(gpu, &staging)
 }
 
 /// Copies one layer of a texture with 4-byte texels per channel group into tightly packed
@@ -74,7 +69,7 @@ fn read_layer_bytes(
         wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
     );
     gpu.submit_and_wait(encoder)?;
-    let bytes = map_read(gpu, &buffer)?;
+    let bytes = read_mapped(gpu, &buffer)?;
     Ok(bytes.chunks_exact(padded as usize).flat_map(|r| r[..row as usize].to_vec()).collect())
 }
 

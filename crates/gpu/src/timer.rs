@@ -60,7 +60,7 @@ impl Gpu {
         encoder.resolve_query_set(&set, 0..2, &resolve, 0);
         encoder.copy_buffer_to_buffer(&resolve, 0, &read, 0, 16);
         self.submit_and_wait(encoder)?;
-        let bytes = crate::readback::map_read(self, &read)?;
+        let bytes = crate::readback::read_mapped(self, &read)?;
         let ticks: [u64; 2] = bytemuck::pod_read_unaligned(&bytes[..16]);
         let ns = ticks[1].saturating_sub(ticks[0]) as f64 * f64::from(self.queue.get_timestamp_period());
         Ok((Duration::from_nanos(ns as u64), Clock::GpuTimestamps))
