@@ -19,7 +19,7 @@ fn decomposition(c: &mut Criterion) {
     for (name, scale) in [("indirects_full", 1), ("indirects_half", 2), ("indirects_quarter", 4)] {
         group.bench_function(name, |b| {
             b.iter_custom(|iters| {
-                (0..iters).map(|_| envshadow_benches::ok(frame.render(&gpu, scale)).0).sum::<Duration>()
+                (0..iters).map(|_| envshadow_benches::ok(frame.render_timed(&gpu, scale)).0).sum::<Duration>()
             });
         });
     }

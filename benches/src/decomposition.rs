@@ -6,9 +6,9 @@
 
 use envmap_sphere::EnvMap;
 use gpu::{
-    Background, GBufferPass, Gpu, GpuError, JointBilateral, LightShape, PrefilterSettings, Receivers, SceneGeometry,
-    ShadeLight, ShadingPass, ShadowTechnique, SpecularAmbient, SplitFrame, SplitPasses, SplitSettings, UpsamplePass,
-    Visibility, WEBER_FRACTION, render_split, render_visibility, weber_negligible,
+    Background, GBufferPass, Gpu, GpuError, JointBilateral, LightShape, PointsRead, PrefilterSettings, Receivers,
+    SceneGeometry, ShadeLight, ShadingPass, ShadowTechnique, SpecularAmbient, SplitFrame, SplitPasses, SplitSettings,
+    UpsamplePass, Visibility, WEBER_FRACTION, indirect_camera, record_split, record_visibility, weber_negligible,
 };
 use light_extract::Decomposition;
 use penumbra_wedge::{WedgeSettings, Wedges};
@@ -71,9 +71,18 @@ impl Frame {
     /// # Errors
     /// An unknown scene or method; GPU failures.
     pub fn new(gpu: &Gpu, scene_name: &str, size: (u32, u32), map: &EnvMap, lights: usize) -> Result<Self, String> {
-        let e = |e: GpuError| e.to_string();
         let mut scene = scene::Scene::builtin(scene_name).map_err(|e| e.to_string())?;
         (scene.camera.width, scene.camera.height) = size;
+        Self::with_scene(gpu, scene, map, lights)
+    }
+
+    /// Sets up `scene` (its camera's size is the frame's), lit by `map` decomposed into
+    /// `lights` lights.
+    ///
+    /// # Errors
+    /// An unknown method; GPU failures.
+    pub fn with_scene(gpu: &Gpu, scene: scene::Scene, map: &EnvMap, lights: usize) -> Result<Self, String> {
+        let e = |e: GpuError| e.to_string();
         let extractor = light_extract::extractor(METHOD, lights).ok_or("unknown method")?;
         let mut decomposition = extractor.extract(map).map_err(|e| e.to_string())?;
         decomposition.sort_directs_first();
@@ -92,20 +101,19 @@ impl Frame {
         })
     }
 
-    /// Moves object `object` to its rest pose translated by `offset`: the techniques are built
-    /// afresh for the new pose (geometry uploaded again, casters welded again, pipelines created
-    /// again).
+    /// Moves object `object` to its rest pose translated by `offset`. Nothing is built: the
+    /// object's vertices are written into the G-buffer's and the maps' geometry
+    /// (`queue.write_buffer`) and its wedge caster welded again on the CPU.
     ///
     /// # Errors
-    /// An object index out of range; GPU failures.
+    /// An object index out of range.
     pub fn move_object(&mut self, gpu: &Gpu, object: usize, offset: glam::Vec3) -> Result<(), GpuError> {
         let rest = self.rest.objects.get(object).ok_or_else(|| GpuError::Failed(format!("no object {object}")))?;
         let moved = rest.mesh.positions.iter().map(|p| *p + offset).collect();
         self.scene.objects[object].mesh.positions = moved;
-        self.geometry = SceneGeometry::upload(gpu, &self.scene)?;
-        self.wedges = Wedges::new(gpu, &self.scene, WedgeSettings::default());
-        self.maps = MapTechnique::new(gpu, &self.scene, Technique::Orthographic, maps_settings(), 1)?;
-        Ok(())
+        self.geometry.update_object(gpu, &self.scene, object)?;
+        self.wedges.update_object(&self.scene, object)?;
+        self.maps.update_object(gpu, &self.scene, object)
     }
 
     /// The scene as built, before any object moved ([`Frame::move_object`] offsets from it).
@@ -114,30 +122,48 @@ impl Frame {
         &self.rest
     }
 
-    /// Renders one frame with the EnvIndirects at 1 / `scale` and returns its wall time (GPU
-    /// work waited for, CPU work included) and the image.
+    /// Renders one frame with the EnvIndirects at 1 / `scale` and returns the image, its work
+    /// submitted and not waited for. Two submissions: the G-buffers with the copies of their
+    /// points, mapped back (one wait: the receivers are still computed on the CPU), then
+    /// everything else recorded into one encoder.
     ///
     /// # Errors
     /// GPU failures; a scale that does not divide the size.
-    pub fn render(&self, gpu: &Gpu, scale: u32) -> Result<(Duration, wgpu::Texture), GpuError> {
-        let start = Instant::now();
+    pub fn render(&self, gpu: &Gpu, scale: u32) -> Result<wgpu::Texture, GpuError> {
         let d = &self.decomposition;
         let lights: Vec<ShadeLight> = d.lights.iter().map(|l| ShadeLight::from(&l.light)).collect();
         let shapes: Vec<LightShape> = d.lights.iter().map(|l| LightShape::from(&l.light)).collect();
         let directs = d.directs();
-        let gb = self.gbuffer.render(gpu, &self.geometry, &self.scene.camera)?;
-        let points = gb.read_points(gpu)?;
-        let receivers = Receivers::new(&gb, &points);
+        let settings = SplitSettings { indirect_scale: scale, upsample: JointBilateral::PAPER };
+        let low_camera = indirect_camera(&self.scene.camera, &settings)?;
+        let mut encoder = gpu.encoder("frame g-buffers");
+        let gb = self.gbuffer.record(gpu, &mut encoder, &self.geometry, &self.scene.camera)?;
+        let low_gb =
+            (scale != 1).then(|| self.gbuffer.record(gpu, &mut encoder, &self.geometry, &low_camera)).transpose()?;
+        let mut reads = vec![gb.record_points(gpu, &mut encoder)?];
+        if let Some(l) = &low_gb {
+            reads.push(l.record_points(gpu, &mut encoder)?);
+        }
+        gpu.submit(encoder);
+        let points = PointsRead::finish_all(gpu, reads)?;
+        let receivers = Receivers::new(&gb, &points[0]);
+        let low_receivers = low_gb.as_ref().map(|l| Receivers::new(l, &points[1]));
+        let low = low_receivers.as_ref().unwrap_or(&receivers);
+
+        let mut encoder = gpu.encoder("frame");
         let (w, h) = gb.size();
-        let vis = Visibility::new(gpu, w, h, directs as u32)?;
+        let vis = Visibility::allocate(gpu, w, h, directs as u32)?;
+        vis.record_clear(&mut encoder);
         let negligible = weber_negligible(&receivers, &lights, Some(&d.ambient_sh), WEBER_FRACTION);
         let wedges: &dyn ShadowTechnique = &self.wedges;
-        render_visibility(gpu, wedges, &receivers, &shapes[..directs], &negligible[..directs], &vis)?;
-        let split = render_split(
+        record_visibility(gpu, &mut encoder, wedges, &receivers, &shapes[..directs], &negligible[..directs], &vis)?;
+        let split = record_split(
             gpu,
+            &mut encoder,
             &SplitPasses { gbuffer: &self.gbuffer, shading: &self.shading, upsample: &self.upsample },
             &self.geometry,
             (&receivers, &vis),
+            low,
             &SplitFrame {
                 lights: &lights,
                 shapes: &shapes,
@@ -147,8 +173,21 @@ impl Frame {
                 background: Some(&self.background),
             },
             &self.maps,
-            &SplitSettings { indirect_scale: scale, upsample: JointBilateral::PAPER },
+            &settings,
         )?;
-        Ok((start.elapsed(), split.texture))
+        gpu.submit(encoder);
+        Ok(split.texture)
+    }
+
+    /// [`Frame::render`] waited for: the wall time of the whole frame (CPU work included) and
+    /// the image.
+    ///
+    /// # Errors
+    /// As [`Frame::render`].
+    pub fn render_timed(&self, gpu: &Gpu, scale: u32) -> Result<(Duration, wgpu::Texture), GpuError> {
+        let start = Instant::now();
+        let texture = self.render(gpu, scale)?;
+        gpu.wait(None)?;
+        Ok((start.elapsed(), texture))
     }
 }

@@ -9,7 +9,7 @@ use gpu::Gpu;
 
 fn frame_image(gpu: &Gpu, map: &EnvMap, lights: usize) -> (Vec<Vec3>, Frame) {
     let frame = Frame::new(gpu, "spheres_box", (96, 72), map, lights).unwrap_or_else(|e| panic!("{e}"));
-    let (_, texture) = frame.render(gpu, 2).unwrap_or_else(|e| panic!("{e}"));
+    let (_, texture) = frame.render_timed(gpu, 2).unwrap_or_else(|e| panic!("{e}"));
     (gpu::read_hdr(gpu, &texture).unwrap(), frame)
 }
 
@@ -61,5 +61,33 @@ fn a_constant_map_lights_the_ground_as_the_ray_traced_truth() {
         let (gpu_mean, truth_mean) = (mean(&image), mean(&truth.color));
         assert!(image.iter().all(|c| c.is_finite()));
         assert!((gpu_mean / truth_mean - 1.0).abs() < tolerance, "K = {k}: frame {gpu_mean}, ray traced {truth_mean}");
+    }
+}
+
+#[test]
+fn a_moving_object_frame_equals_a_frame_built_for_its_pose() {
+    use envshadow_benches::decomposition::{animated_object, animation_offset};
+    let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
+    let mut map = EnvMap::constant(128, 64, Vec3::splat(0.3));
+    map.set_pixel(20, 14, Vec3::splat(4000.0));
+    map.set_pixel(90, 22, Vec3::splat(800.0));
+    let mut frame = Frame::new(&gpu, "spheres_box", (96, 72), &map, 8).unwrap_or_else(|e| panic!("{e}"));
+    let image = |f: &Frame, scale| gpu::read_hdr(&gpu, &f.render_timed(&gpu, scale).unwrap().1).unwrap();
+    let at_rest = image(&frame, 2);
+    let object = animated_object(&frame.scene);
+    frame.move_object(&gpu, object, animation_offset(frame.rest(), object, 5)).unwrap();
+    // a frame after the first costs two submissions, one wait and no pipeline
+    let before = gpu.counters();
+    let texture = frame.render(&gpu, 2).unwrap();
+    let d = gpu.counters() - before;
+    assert_eq!((d.submits, d.waits, d.pipelines), (2, 1, 0), "{d:?}");
+    let moved = gpu::read_hdr(&gpu, &texture).unwrap();
+    assert!(moved != at_rest, "the object did not move");
+    let fresh = Frame::with_scene(&gpu, frame.scene.clone(), &map, 8).unwrap_or_else(|e| panic!("{e}"));
+    for scale in [1, 2] {
+        assert!(
+            image(&frame, scale) == image(&fresh, scale),
+            "scale {scale}: the moved frame differs from a fresh one"
+        );
     }
 }

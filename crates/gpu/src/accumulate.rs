@@ -25,6 +25,7 @@ pub const ADD: wgpu::BlendState = wgpu::BlendState {
 };
 
 /// A screen-sized two-channel float target that passes add into.
+#[derive(Clone)]
 pub struct Accumulator {
     /// The texture (`format`).
     pub texture: wgpu::Texture,
@@ -136,18 +137,7 @@ impl ResolvePass {
             layout: &self.pipeline.get_bind_group_layout(0),
             entries: &entries,
         });
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("resolve"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: target,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::WHITE), store: wgpu::StoreOp::Store },
-            })],
-            ..Default::default()
-        });
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &bind, &[]);
-        pass.draw(0..3, 0..1);
+        let clear = wgpu::LoadOp::Clear(wgpu::Color::WHITE);
+        crate::fullscreen::record(encoder, &self.pipeline, &bind, target, clear);
     }
 }

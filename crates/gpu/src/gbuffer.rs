@@ -106,11 +106,29 @@ impl GBufferPass {
         Self { pipeline }
     }
 
-    /// Renders the G-buffer of `geometry` seen by `camera`.
+    /// Renders the G-buffer of `geometry` seen by `camera` and waits for it.
     ///
     /// # Errors
     /// [`GpuError::TooLarge`] for an image beyond the adapter's limits; GPU failures.
     pub fn render(&self, gpu: &Gpu, geometry: &SceneGeometry, camera: &scene::Camera) -> Result<GBuffer, GpuError> {
+        let mut encoder = gpu.encoder("gbuffer");
+        let gb = self.record(gpu, &mut encoder, geometry, camera)?;
+        gpu.submit_and_wait(encoder)?;
+        Ok(gb)
+    }
+
+    /// Records the G-buffer pass of `geometry` seen by `camera` into `encoder`, without
+    /// submitting: the returned targets hold the G-buffer once the caller's submission runs.
+    ///
+    /// # Errors
+    /// [`GpuError::TooLarge`] for an image beyond the adapter's limits.
+    pub fn record(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        geometry: &SceneGeometry,
+        camera: &scene::Camera,
+    ) -> Result<GBuffer, GpuError> {
         let size = (camera.width, camera.height, 1);
         let target = |label, format| crate::target::render_target(gpu, label, size, format);
         let gb = GBuffer {
@@ -155,7 +173,6 @@ impl GBufferPass {
             })
             .collect();
         let depth_view = gb.depth.create_view(&Default::default());
-        let mut encoder = gpu.encoder("gbuffer");
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("gbuffer"),
@@ -174,7 +191,6 @@ impl GBufferPass {
             pass.set_vertex_buffer(0, geometry.vertices.slice(..));
             pass.draw(0..geometry.vertex_count, 0..1);
         }
-        gpu.submit_and_wait(encoder)?;
         Ok(gb)
     }
 }
@@ -200,18 +216,23 @@ impl GBuffer {
     /// # Errors
     /// GPU failures.
     pub fn read_points(&self, gpu: &Gpu) -> Result<Vec<(Vec3, Vec3)>, GpuError> {
-        let p = self.read_positions(gpu)?;
-        let n = self.read_geometric_normals(gpu)?;
-        Ok(p.iter()
-            .zip(&n)
-            .map(|(p, n)| {
-                if p[3] < 0.0 {
-                    (Vec3::NAN, Vec3::ZERO)
-                } else {
-                    (Vec3::new(p[0], p[1], p[2]), Vec3::new(n[0], n[1], n[2]))
-                }
-            })
-            .collect())
+        let mut encoder = gpu.encoder("gbuffer points");
+        let read = self.record_points(gpu, &mut encoder)?;
+        gpu.submit(encoder);
+        Ok(PointsRead::finish_all(gpu, vec![read])?.swap_remove(0))
+    }
+
+    /// Records the copies [`GBuffer::read_points`] maps, so that they travel in the caller's
+    /// submission; [`PointsRead::finish_all`] maps them after it.
+    ///
+    /// # Errors
+    /// GPU failures.
+    pub fn record_points(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder) -> Result<PointsRead, GpuError> {
+        let all = wgpu::TextureAspect::All;
+        Ok(PointsRead {
+            position: crate::readback::PendingRead::record(gpu, encoder, &self.position, 0, all)?,
+            normal: crate::readback::PendingRead::record(gpu, encoder, &self.geometric_normal, 0, all)?,
+        })
     }
 
     /// Reads the geometric normals back, row-major.
@@ -220,5 +241,41 @@ impl GBuffer {
     /// GPU failures.
     pub fn read_geometric_normals(&self, gpu: &Gpu) -> Result<Vec<[f32; 4]>, GpuError> {
         crate::readback::read_texture_rgba(gpu, &self.geometric_normal, 0)
+    }
+}
+
+/// A G-buffer's points on their way back ([`GBuffer::record_points`]).
+pub struct PointsRead {
+    position: crate::readback::PendingRead,
+    normal: crate::readback::PendingRead,
+}
+
+impl PointsRead {
+    /// Maps every read (their encoders submitted) with one wait: per G-buffer its points, as
+    /// [`GBuffer::read_points`].
+    ///
+    /// # Errors
+    /// GPU failures.
+    pub fn finish_all(gpu: &Gpu, reads: Vec<PointsRead>) -> Result<Vec<Vec<(Vec3, Vec3)>>, GpuError> {
+        let pending: Vec<crate::readback::PendingRead> =
+            reads.into_iter().flat_map(|r| [r.position, r.normal]).collect();
+        let bytes = crate::readback::PendingRead::finish_all(gpu, &pending)?;
+        Ok(bytes
+            .chunks_exact(2)
+            .map(|pair| {
+                let p: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&pair[0]);
+                let n: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&pair[1]);
+                p.iter()
+                    .zip(&n)
+                    .map(|(p, n)| {
+                        if p[3] < 0.0 {
+                            (Vec3::NAN, Vec3::ZERO)
+                        } else {
+                            (Vec3::new(p[0], p[1], p[2]), Vec3::new(n[0], n[1], n[2]))
+                        }
+                    })
+                    .collect()
+            })
+            .collect())
     }
 }

@@ -37,6 +37,8 @@ pub struct SceneGeometry {
     pub(crate) materials: wgpu::Buffer,
     /// Axis-aligned bounds of the scene.
     pub bounds: (Vec3, Vec3),
+    // per object: first vertex, vertex count, bounds
+    objects: Vec<(u32, u32, (Vec3, Vec3))>,
 }
 
 /// Largest vertex count we upload (16 M triangles): refused before allocating.
@@ -51,6 +53,33 @@ fn check_count(gpu: &Gpu, vertices: usize, stride: u64) -> Result<(), GpuError> 
     Ok(())
 }
 
+/// Object `k`'s G-buffer vertices (three per triangle) and their bounds.
+fn object_vertices(k: usize, object: &scene::Object) -> (Vec<ShadedVertex>, (Vec3, Vec3)) {
+    let mesh = &object.mesh;
+    let mut vertices = Vec::with_capacity(mesh.indices.len() * 3);
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for (t, tri) in mesh.indices.iter().enumerate() {
+        let ng = mesh.geometric_normal(t).normalize_or_zero();
+        for &i in tri {
+            let p = mesh.positions[i as usize];
+            lo = lo.min(p);
+            hi = hi.max(p);
+            let n = mesh.normals.as_ref().map_or(ng, |n| n[i as usize]);
+            vertices.push(ShadedVertex {
+                position: p.to_array(),
+                normal: n.to_array(),
+                geometric_normal: ng.to_array(),
+                object: k as u32,
+            });
+        }
+    }
+    (vertices, (lo, hi))
+}
+
+fn union(boxes: impl Iterator<Item = (Vec3, Vec3)>) -> (Vec3, Vec3) {
+    boxes.fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), (a, b)| (lo.min(a), hi.max(b)))
+}
+
 impl SceneGeometry {
     /// Uploads every object of `scene`, flat or smooth as its mesh says.
     ///
@@ -60,24 +89,11 @@ impl SceneGeometry {
         let count: usize = scene.objects.iter().map(|o| o.mesh.indices.len() * 3).sum();
         check_count(gpu, count, std::mem::size_of::<ShadedVertex>() as u64)?;
         let mut vertices = Vec::with_capacity(count);
-        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        let mut objects = Vec::with_capacity(scene.objects.len());
         for (k, object) in scene.objects.iter().enumerate() {
-            let mesh = &object.mesh;
-            for (t, tri) in mesh.indices.iter().enumerate() {
-                let ng = mesh.geometric_normal(t).normalize_or_zero();
-                for &i in tri {
-                    let p = mesh.positions[i as usize];
-                    lo = lo.min(p);
-                    hi = hi.max(p);
-                    let n = mesh.normals.as_ref().map_or(ng, |n| n[i as usize]);
-                    vertices.push(ShadedVertex {
-                        position: p.to_array(),
-                        normal: n.to_array(),
-                        geometric_normal: ng.to_array(),
-                        object: k as u32,
-                    });
-                }
-            }
+            let (v, bounds) = object_vertices(k, object);
+            objects.push((vertices.len() as u32, v.len() as u32, bounds));
+            vertices.extend(v);
         }
         let mut materials: Vec<GpuMaterial> = scene.objects.iter().map(|o| GpuMaterial::new(&o.material)).collect();
         if materials.is_empty() {
@@ -87,7 +103,7 @@ impl SceneGeometry {
         let vertices_buf = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("scene vertices"),
             contents: bytemuck::cast_slice(&vertices),
-            usage: wgpu::BufferUsages::VERTEX,
+            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
         });
         let materials_buf = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("materials"),
@@ -98,8 +114,36 @@ impl SceneGeometry {
             vertices: vertices_buf,
             vertex_count: vertices.len() as u32,
             materials: materials_buf,
-            bounds: (lo, hi),
+            bounds: union(objects.iter().map(|o| o.2)),
+            objects,
         })
+    }
+
+    /// Writes object `object`'s vertices from its mesh in `scene` (same triangles, new
+    /// positions or normals: a pose change) with `queue.write_buffer`, and updates the bounds:
+    /// what [`SceneGeometry::upload`] of the changed scene would hold, without a new buffer.
+    ///
+    /// # Errors
+    /// [`GpuError::Failed`] for an object out of range or with another triangle count.
+    pub fn update_object(&mut self, gpu: &Gpu, scene: &scene::Scene, object: usize) -> Result<(), GpuError> {
+        let (Some(&(first, count, _)), Some(o)) = (self.objects.get(object), scene.objects.get(object)) else {
+            return Err(GpuError::Failed(format!("scene geometry: no object {object}")));
+        };
+        if o.mesh.indices.len() as u64 * 3 != u64::from(count) {
+            return Err(GpuError::Failed(format!(
+                "scene geometry: object {object} has {} triangles, uploaded with {}",
+                o.mesh.indices.len(),
+                count / 3
+            )));
+        }
+        let (vertices, bounds) = object_vertices(object, o);
+        if !vertices.is_empty() {
+            let offset = u64::from(first) * std::mem::size_of::<ShadedVertex>() as u64;
+            gpu.queue.write_buffer(&self.vertices, offset, bytemuck::cast_slice(&vertices));
+        }
+        self.objects[object].2 = bounds;
+        self.bounds = union(self.objects.iter().map(|o| o.2));
+        Ok(())
     }
 
     pub(crate) const LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
@@ -130,6 +174,20 @@ pub struct ShadowGeometry {
     pub chunks: Vec<Chunk>,
     /// Triangle count.
     pub triangles: u32,
+    // triangles per chunk (the last may have fewer), and every triangle, for bounds updates
+    chunk_triangles: usize,
+    soup: Vec<[Vec3; 3]>,
+}
+
+/// A chunk's bounding sphere: the centre of its box and the farthest vertex from it.
+fn chunk_sphere(tris: &[[Vec3; 3]]) -> (Vec3, f32) {
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for p in tris.iter().flatten() {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
+    }
+    let center = 0.5 * (lo + hi);
+    (center, tris.iter().flatten().map(|p| p.distance(center)).fold(0.0, f32::max))
 }
 
 impl ShadowGeometry {
@@ -147,13 +205,7 @@ impl ShadowGeometry {
             .chunks(chunk_triangles.max(1))
             .enumerate()
             .map(|(k, tris)| {
-                let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-                for p in tris.iter().flatten() {
-                    lo = lo.min(*p);
-                    hi = hi.max(*p);
-                }
-                let center = 0.5 * (lo + hi);
-                let radius = tris.iter().flatten().map(|p| p.distance(center)).fold(0.0, f32::max);
+                let (center, radius) = chunk_sphere(tris);
                 let first = (k * chunk_triangles.max(1) * 3) as u32;
                 Chunk { first_vertex: first, vertex_count: (tris.len() * 3) as u32, center, radius }
             })
@@ -162,9 +214,45 @@ impl ShadowGeometry {
         let vertices = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("shadow vertices"),
             contents: bytemuck::cast_slice(if flat.is_empty() { &[[0.0f32; 3]; 3][..] } else { &flat[..] }),
-            usage: wgpu::BufferUsages::VERTEX,
+            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
         });
-        Ok(Self { vertices, chunks, triangles: triangles.len() as u32 })
+        Ok(Self {
+            vertices,
+            chunks,
+            triangles: triangles.len() as u32,
+            chunk_triangles: chunk_triangles.max(1),
+            soup: triangles.to_vec(),
+        })
+    }
+
+    /// Replaces triangles `first..first + triangles.len()` (a moved object's) with
+    /// `queue.write_buffer` and recomputes the bounds of the chunks they fall in: what
+    /// [`ShadowGeometry::upload`] of the changed soup would give, without a new buffer.
+    ///
+    /// # Errors
+    /// [`GpuError::Failed`] for a range past the end.
+    pub fn update(&mut self, gpu: &Gpu, first: usize, triangles: &[[Vec3; 3]]) -> Result<(), GpuError> {
+        let end = first.checked_add(triangles.len()).filter(|&e| e <= self.soup.len()).ok_or_else(|| {
+            GpuError::Failed(format!(
+                "shadow geometry: triangles {first}.. ({}) past its {}",
+                triangles.len(),
+                self.soup.len()
+            ))
+        })?;
+        if triangles.is_empty() {
+            return Ok(());
+        }
+        self.soup[first..end].copy_from_slice(triangles);
+        let flat: Vec<[f32; 3]> = triangles.iter().flatten().map(|p| p.to_array()).collect();
+        gpu.queue.write_buffer(&self.vertices, first as u64 * 36, bytemuck::cast_slice(&flat));
+        let n = self.chunk_triangles;
+        for k in first / n..end.div_ceil(n) {
+            let tris = &self.soup[k * n..((k + 1) * n).min(self.soup.len())];
+            let (center, radius) = chunk_sphere(tris);
+            self.chunks[k].center = center;
+            self.chunks[k].radius = radius;
+        }
+        Ok(())
     }
 
     /// Vertex layout: one `vec3<f32>` position at location 0.

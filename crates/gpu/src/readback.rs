@@ -7,18 +7,35 @@ use crate::context::{Gpu, GpuError};
 /// # Errors
 /// [`GpuError::Failed`] when the wait or the mapping fails.
 pub fn read_mapped(gpu: &Gpu, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
-    let (tx, rx) = std::sync::mpsc::channel();
-    buffer.map_async(wgpu::MapMode::Read, .., move |r| {
-        let _ = tx.send(r);
-    });
+    Ok(read_mapped_all(gpu, &[buffer])?.swap_remove(0))
+}
+
+/// Maps every one of `buffers` (as [`read_mapped`]) with one wait for all of them.
+///
+/// # Errors
+/// [`GpuError::Failed`] when the wait or a mapping fails.
+pub fn read_mapped_all(gpu: &Gpu, buffers: &[&wgpu::Buffer]) -> Result<Vec<Vec<u8>>, GpuError> {
+    let receivers: Vec<_> = buffers
+        .iter()
+        .map(|buffer| {
+            let (tx, rx) = std::sync::mpsc::channel();
+            buffer.map_async(wgpu::MapMode::Read, .., move |r| {
+                let _ = tx.send(r);
+            });
+            rx
+        })
+        .collect();
     gpu.wait(None)?;
-    gpu.count_readback(buffer.size());
-    rx.recv()
-        .map_err(|e| GpuError::Failed(e.to_string()))?
-        .map_err(|e| GpuError::Failed(format!("mapping a readback buffer: {e}")))?;
-    let bytes = buffer.get_mapped_range(..).map_err(|e| GpuError::Failed(e.to_string()))?.to_vec();
-    buffer.unmap();
-    Ok(bytes)
+    let mut out = Vec::with_capacity(buffers.len());
+    for (buffer, rx) in buffers.iter().zip(receivers) {
+        gpu.count_readback(buffer.size());
+        rx.recv()
+            .map_err(|e| GpuError::Failed(e.to_string()))?
+            .map_err(|e| GpuError::Failed(format!("mapping a readback buffer: {e}")))?;
+        out.push(buffer.get_mapped_range(..).map_err(|e| GpuError::Failed(e.to_string()))?.to_vec());
+        buffer.unmap();
+    }
+    Ok(out)
 }
 
 /// Copies `buffer` (which needs `COPY_SRC`) back to the CPU.
@@ -38,6 +55,72 @@ pub fn read_buffer(gpu: &Gpu, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError
     read_mapped(gpu, &staging)
 }
 
+/// A texture layer's copy recorded into an encoder, to be mapped once the encoder has run.
+pub struct PendingRead {
+    buffer: wgpu::Buffer,
+    row: u32,
+    padded: u32,
+}
+
+impl PendingRead {
+    /// Records the copy of one layer of `texture` (`aspect` of it) into a buffer of its own.
+    ///
+    /// # Errors
+    /// [`GpuError::Failed`] for a format that cannot be copied back.
+    pub fn record(
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        texture: &wgpu::Texture,
+        layer: u32,
+        aspect: wgpu::TextureAspect,
+    ) -> Result<Self, GpuError> {
+        let (w, h) = (texture.width(), texture.height());
+        let bpp = texture
+            .format()
+            .block_copy_size(Some(aspect))
+            .ok_or_else(|| GpuError::Failed(format!("cannot read back {:?}", texture.format())))?;
+        let row = w * bpp;
+        let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: u64::from(padded) * u64::from(h),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        encoder.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d { x: 0, y: 0, z: layer },
+                aspect,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(padded), rows_per_image: Some(h) },
+            },
+            wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+        );
+        Ok(Self { buffer, row, padded })
+    }
+
+    /// Maps every read (their encoders submitted) with one wait; per read its tightly packed
+    /// bytes, row by row.
+    ///
+    /// # Errors
+    /// [`GpuError::Failed`] when the wait or a mapping fails.
+    pub fn finish_all(gpu: &Gpu, reads: &[PendingRead]) -> Result<Vec<Vec<u8>>, GpuError> {
+        let buffers: Vec<&wgpu::Buffer> = reads.iter().map(|r| &r.buffer).collect();
+        let mapped = read_mapped_all(gpu, &buffers)?;
+        Ok(reads
+            .iter()
+            .zip(mapped)
+            .map(|(r, bytes)| {
+                bytes.chunks_exact(r.padded as usize).flat_map(|b| b[..r.row as usize].to_vec()).collect()
+            })
+            .collect())
+    }
+}
+
 /// Copies one layer of a texture with 4-byte texels per channel group into tightly packed
 /// bytes, row by row.
 fn read_layer_bytes(
@@ -46,31 +129,10 @@ fn read_layer_bytes(
     layer: u32,
     aspect: wgpu::TextureAspect,
 ) -> Result<Vec<u8>, GpuError> {
-    let (w, h) = (texture.width(), texture.height());
-    let bpp = texture
-        .format()
-        .block_copy_size(Some(aspect))
-        .ok_or_else(|| GpuError::Failed(format!("cannot read back {:?}", texture.format())))?;
-    let row = w * bpp;
-    let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-    let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("readback"),
-        size: u64::from(padded) * u64::from(h),
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
     let mut encoder = gpu.encoder("readback");
-    encoder.copy_texture_to_buffer(
-        wgpu::TexelCopyTextureInfo { texture, mip_level: 0, origin: wgpu::Origin3d { x: 0, y: 0, z: layer }, aspect },
-        wgpu::TexelCopyBufferInfo {
-            buffer: &buffer,
-            layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(padded), rows_per_image: Some(h) },
-        },
-        wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-    );
-    gpu.submit_and_wait(encoder)?;
-    let bytes = read_mapped(gpu, &buffer)?;
-    Ok(bytes.chunks_exact(padded as usize).flat_map(|r| r[..row as usize].to_vec()).collect())
+    let read = PendingRead::record(gpu, &mut encoder, texture, layer, aspect)?;
+    gpu.submit(encoder);
+    Ok(PendingRead::finish_all(gpu, &[read])?.swap_remove(0))
 }
 
 /// Reads one layer of a single-channel texture as floats, row-major from the top-left: R32Float

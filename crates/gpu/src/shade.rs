@@ -75,15 +75,32 @@ impl Visibility {
     /// Format of the layers.
     pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
 
-    /// `layers` layers of `width` × `height`, all lit (1).
+    /// `layers` layers of `width` × `height`, all lit (1); waits for the clear.
     ///
     /// # Errors
     /// [`GpuError::TooLarge`] beyond the adapter's limits.
     pub fn new(gpu: &Gpu, width: u32, height: u32, layers: u32) -> Result<Self, GpuError> {
-        let texture = crate::target::render_target(gpu, "visibility", (width, height, layers.max(1)), Self::FORMAT)?;
+        let vis = Self::allocate(gpu, width, height, layers)?;
         let mut encoder = gpu.encoder("visibility clear");
-        for layer in 0..texture.depth_or_array_layers() {
-            let view = layer_view(&texture, layer);
+        vis.record_clear(&mut encoder);
+        gpu.submit_and_wait(encoder)?;
+        Ok(vis)
+    }
+
+    /// `layers` layers of `width` × `height` (at least one), contents undefined until
+    /// [`Visibility::record_clear`] or a technique writes them.
+    ///
+    /// # Errors
+    /// [`GpuError::TooLarge`] beyond the adapter's limits.
+    pub fn allocate(gpu: &Gpu, width: u32, height: u32, layers: u32) -> Result<Self, GpuError> {
+        let texture = crate::target::render_target(gpu, "visibility", (width, height, layers.max(1)), Self::FORMAT)?;
+        Ok(Self { texture })
+    }
+
+    /// Records setting every layer to lit (1).
+    pub fn record_clear(&self, encoder: &mut wgpu::CommandEncoder) {
+        for layer in 0..self.texture.depth_or_array_layers() {
+            let view = layer_view(&self.texture, layer);
             encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("visibility clear"),
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -98,8 +115,12 @@ impl Visibility {
                 ..Default::default()
             });
         }
-        gpu.submit_and_wait(encoder)?;
-        Ok(Self { texture })
+    }
+
+    /// Size of a layer.
+    #[must_use]
+    pub fn size(&self) -> (u32, u32) {
+        (self.texture.width(), self.texture.height())
     }
 
     /// A render-target view of one layer (for a shadow technique to write).
@@ -183,14 +204,35 @@ impl ShadingPass {
         read_hdr(gpu, &output)
     }
 
-    /// Shades `gbuffer` into a new [`HDR_FORMAT`] texture of its size, left on the GPU.
+    /// Shades `gbuffer` into a new [`HDR_FORMAT`] texture of its size, left on the GPU, and
+    /// waits for it.
     ///
     /// # Errors
-    /// [`GpuError::TooLarge`] when `visibility` has fewer layers than lights or the map is too
-    /// large; GPU failures.
+    /// As [`ShadingPass::record_texture`]; GPU failures.
     pub fn render_texture(
         &self,
         gpu: &Gpu,
+        geometry: &SceneGeometry,
+        gbuffer: &GBuffer,
+        params: &ShadeParams,
+        visibility: &Visibility,
+    ) -> Result<wgpu::Texture, GpuError> {
+        let mut encoder = gpu.encoder("shade");
+        let output = self.record_texture(gpu, &mut encoder, geometry, gbuffer, params, visibility)?;
+        gpu.submit_and_wait(encoder)?;
+        Ok(output)
+    }
+
+    /// Records shading `gbuffer` into a new [`HDR_FORMAT`] texture of its size, without
+    /// submitting.
+    ///
+    /// # Errors
+    /// [`GpuError::TooLarge`] when `visibility` has fewer layers than lights or the image is
+    /// too large.
+    pub fn record_texture(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
         geometry: &SceneGeometry,
         gbuffer: &GBuffer,
         params: &ShadeParams,
@@ -272,7 +314,7 @@ impl ShadingPass {
             ],
         });
         let out_view = output.create_view(&Default::default());
-        crate::fullscreen::draw(gpu, &self.pipeline, &bind, &out_view, wgpu::Color::BLACK)?;
+        crate::fullscreen::record(encoder, &self.pipeline, &bind, &out_view, wgpu::LoadOp::Clear(wgpu::Color::BLACK));
         Ok(output)
     }
 }

@@ -10,7 +10,7 @@ use crate::gbuffer::GBufferPass;
 use crate::geometry::SceneGeometry;
 use crate::shade::{Background, ShadeLight, ShadeParams, ShadingPass, Visibility};
 use crate::technique::{
-    LightShape, Receivers, ShadowPassReport, ShadowTechnique, WEBER_FRACTION, render_visibility, weber_negligible,
+    LightShape, Receivers, ShadowPassReport, ShadowTechnique, WEBER_FRACTION, record_visibility, weber_negligible,
 };
 use crate::upsample::{JointBilateral, UpsamplePass};
 use envmap_sphere::Sh9;
@@ -69,15 +69,26 @@ pub struct SplitImage {
     pub indirect_size: (u32, u32),
 }
 
-/// Renders a split frame over `receivers` (the full-resolution G-buffer and its points). The
-/// EnvDirects' visibility comes in `direct_visibility` (layer k for light k < `directs`, made
-/// by the caller with any technique); the EnvIndirects' is made here with `indirect` at the
-/// reduced resolution, skipping lights no receiver faces and those Weber's law finds
-/// negligible there.
+/// The camera the EnvIndirects are shaded from: `camera` at 1 / `settings.indirect_scale` of
+/// its size.
 ///
 /// # Errors
-/// [`GpuError::Failed`] for a scale that does not divide the G-buffer's size or more directs
-/// than lights; GPU failures.
+/// [`GpuError::Failed`] for a scale that does not divide the camera's size.
+pub fn indirect_camera(camera: &scene::Camera, settings: &SplitSettings) -> Result<scene::Camera, GpuError> {
+    let (w, h) = (camera.width, camera.height);
+    let f = settings.indirect_scale;
+    if f == 0 || !w.is_multiple_of(f) || !h.is_multiple_of(f) {
+        return Err(GpuError::Failed(format!("EnvIndirects at 1/{f} of {w}x{h}: the scale must divide both sides")));
+    }
+    Ok(scene::Camera { width: w / f, height: h / f, ..*camera })
+}
+
+/// Renders a split frame over `receivers` (the full-resolution G-buffer and its points) and
+/// waits for it: the low-resolution G-buffer is rendered and read here, then
+/// [`record_split`] records the rest in one submission.
+///
+/// # Errors
+/// As [`record_split`]; GPU failures.
 pub fn render_split(
     gpu: &Gpu,
     passes: &SplitPasses,
@@ -87,11 +98,62 @@ pub fn render_split(
     indirect: &dyn ShadowTechnique,
     settings: &SplitSettings,
 ) -> Result<SplitImage, GpuError> {
+    let low_camera = indirect_camera(&receivers.gbuffer.camera, settings)?;
+    let (low_gb, low_points, low_receivers);
+    let low = if settings.indirect_scale == 1 {
+        receivers
+    } else {
+        low_gb = passes.gbuffer.render(gpu, geometry, &low_camera)?;
+        low_points = low_gb.read_points(gpu)?;
+        low_receivers = Receivers::new(&low_gb, &low_points);
+        &low_receivers
+    };
+    let mut encoder = gpu.encoder("split frame");
+    let image = record_split(
+        gpu,
+        &mut encoder,
+        passes,
+        geometry,
+        (receivers, direct_visibility),
+        low,
+        frame,
+        indirect,
+        settings,
+    )?;
+    gpu.submit_and_wait(encoder)?;
+    Ok(image)
+}
+
+/// Records a split frame into `encoder`, without submitting. The EnvDirects' visibility comes
+/// in `direct_visibility` (layer k for light k < `directs`, made by the caller with any
+/// technique); the EnvIndirects' is made here with `indirect` over `low` (the receivers of the
+/// G-buffer `passes.gbuffer` renders from [`indirect_camera`]; `receivers` themselves at scale
+/// 1), skipping lights no receiver faces and those Weber's law finds negligible there.
+///
+/// # Errors
+/// [`GpuError::Failed`] for a scale that does not divide the G-buffer's size, low receivers of
+/// another size, or more directs than lights; the technique's errors.
+#[allow(clippy::too_many_arguments)]
+pub fn record_split(
+    gpu: &Gpu,
+    encoder: &mut wgpu::CommandEncoder,
+    passes: &SplitPasses,
+    geometry: &SceneGeometry,
+    (receivers, direct_visibility): (&Receivers, &Visibility),
+    low: &Receivers,
+    frame: &SplitFrame,
+    indirect: &dyn ShadowTechnique,
+    settings: &SplitSettings,
+) -> Result<SplitImage, GpuError> {
     let gb = receivers.gbuffer;
-    let (w, h) = gb.size();
-    let f = settings.indirect_scale;
-    if f == 0 || !w.is_multiple_of(f) || !h.is_multiple_of(f) {
-        return Err(GpuError::Failed(format!("EnvIndirects at 1/{f} of {w}x{h}: the scale must divide both sides")));
+    let low_camera = indirect_camera(&gb.camera, settings)?;
+    if low.gbuffer.size() != (low_camera.width, low_camera.height) {
+        return Err(GpuError::Failed(format!(
+            "EnvIndirects at 1/{} of {:?}: low receivers of {:?}",
+            settings.indirect_scale,
+            gb.size(),
+            low.gbuffer.size()
+        )));
     }
     if frame.directs > frame.lights.len() || frame.shapes.len() != frame.lights.len() {
         return Err(GpuError::Failed(format!(
@@ -103,8 +165,9 @@ pub fn render_split(
     }
     let (directs, indirects) = frame.lights.split_at(frame.directs);
     let indirect_shapes = &frame.shapes[frame.directs..];
-    let base = passes.shading.render_texture(
+    let base = passes.shading.record_texture(
         gpu,
+        encoder,
         geometry,
         gb,
         &ShadeParams {
@@ -115,30 +178,26 @@ pub fn render_split(
         },
         direct_visibility,
     )?;
-    let low_camera = scene::Camera { width: w / f, height: h / f, ..gb.camera };
-    let (low_gb, low_points, low_receivers);
-    let low = if f == 1 {
-        receivers
-    } else {
-        low_gb = passes.gbuffer.render(gpu, geometry, &low_camera)?;
-        low_points = low_gb.read_points(gpu)?;
-        low_receivers = Receivers::new(&low_gb, &low_points);
-        &low_receivers
-    };
     let (lw, lh) = low.gbuffer.size();
-    let visibility = Visibility::new(gpu, lw, lh, indirects.len() as u32)?;
+    let visibility = Visibility::allocate(gpu, lw, lh, indirects.len() as u32)?;
+    visibility.record_clear(encoder);
     // the directs count towards what a receiver already gets
     let negligible = weber_negligible(low, frame.lights, frame.ambient, WEBER_FRACTION).split_off(frame.directs);
-    let indirect_reports = render_visibility(gpu, indirect, low, indirect_shapes, &negligible, &visibility)?;
-    let shaded = passes.shading.render_texture(
+    let indirect_reports = record_visibility(gpu, encoder, indirect, low, indirect_shapes, &negligible, &visibility)?;
+    let shaded = passes.shading.record_texture(
         gpu,
+        encoder,
         geometry,
         low.gbuffer,
         &ShadeParams { lights: indirects, ..Default::default() },
         &visibility,
     )?;
     // at scale 1 the pass with a 1 x 1 window is the plain sum
-    let upsample = if f == 1 { JointBilateral { radius: 0, ..JointBilateral::GAUSSIAN } } else { settings.upsample };
-    let texture = passes.upsample.render(gpu, geometry, (low.gbuffer, &shaded), (gb, &base), &upsample)?;
+    let upsample = if settings.indirect_scale == 1 {
+        JointBilateral { radius: 0, ..JointBilateral::GAUSSIAN }
+    } else {
+        settings.upsample
+    };
+    let texture = passes.upsample.record(gpu, encoder, geometry, (low.gbuffer, &shaded), (gb, &base), &upsample)?;
     Ok(SplitImage { texture, indirect_reports, indirect_size: (lw, lh) })
 }

@@ -4,9 +4,11 @@
 //! [`ShadowTechnique`]; the shading pass only reads the layers, and `validate` and the trade
 //! report iterate over techniques through it.
 //!
-//! [`render_visibility`] is the frame loop every caller shares: it skips lights that no visible
-//! receiver can see (no shadow pass for a light nobody sees), and those [`weber_negligible`]
-//! finds below Weber's 2 % at every visible receiver, together, and reports what it skipped.
+//! [`record_visibility`] is the frame loop: it records every light's passes into the caller's
+//! encoder, skipping lights that no visible receiver can see (no shadow pass for a light nobody
+//! sees) and those [`weber_negligible`] finds below Weber's 2 % at every visible receiver,
+//! together, and reports what it skipped. [`render_visibility`] is the same loop with each light
+//! submitted, waited for and timed on its own, for measurement.
 
 use crate::context::{Gpu, GpuError};
 use crate::gbuffer::GBuffer;
@@ -146,6 +148,10 @@ pub struct ShadowPassReport {
 }
 
 /// A GPU shadow technique: writes one light's visibility layer (1 lit, 0 shadowed) for a frame.
+///
+/// [`ShadowTechnique::record`] is the real-time path: it records the light's passes into the
+/// caller's encoder and never submits, waits or maps. [`ShadowTechnique::write_visibility`]
+/// wraps it for measurement (one submission, waited for, timed).
 pub trait ShadowTechnique {
     /// Name, e.g. `wedge_raster` or `pcss_2048`; validate's rows prefix it with `gpu_`.
     fn name(&self) -> String;
@@ -153,33 +159,64 @@ pub trait ShadowTechnique {
     /// Whether it can shadow `light` (a cube map cannot shadow a distant light).
     fn supports(&self, light: &LightShape) -> bool;
 
-    /// Writes `light`'s visibility of every G-buffer pixel of `receivers` into `target`.
+    /// Records the passes writing `light`'s visibility of every G-buffer pixel of `receivers`
+    /// into `target`, without submitting. Work recorded for several lights into one encoder
+    /// runs in order, so a technique may reuse its scratch targets from light to light. The
+    /// report's `time` is zero and its `clock` `None` (the caller times the submission).
     ///
     /// # Errors
-    /// A light the technique does not support; GPU failures.
+    /// A light the technique does not support; sizes beyond the device's limits.
+    fn record(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        receivers: &Receivers,
+        light: &LightShape,
+        target: &wgpu::TextureView,
+    ) -> Result<ShadowPassReport, GpuError>;
+
+    /// [`ShadowTechnique::record`] in a submission of its own, waited for and timed: what
+    /// validate, the trade and the benches measure one light with.
+    ///
+    /// # Errors
+    /// As [`ShadowTechnique::record`]; GPU failures.
     fn write_visibility(
         &self,
         gpu: &Gpu,
         receivers: &Receivers,
         light: &LightShape,
         target: &wgpu::TextureView,
-    ) -> Result<ShadowPassReport, GpuError>;
+    ) -> Result<ShadowPassReport, GpuError> {
+        let mut recorded = None;
+        let (time, clock) =
+            gpu.measure(|encoder| recorded = Some(self.record(gpu, encoder, receivers, light, target)))?;
+        let report = recorded.ok_or_else(|| GpuError::Failed(format!("{}: nothing recorded", self.name())))??;
+        Ok(ShadowPassReport { time, clock: Some(clock), ..report })
+    }
 }
 
-/// Writes every light's layer of `visibility` with `technique`, skipping lights that no visible
-/// receiver faces (their layers stay lit: the shading pass gives them nothing there anyway) and
-/// lights marked in `negligible` (e.g. by [`weber_negligible`]; an empty slice marks none).
-///
-/// # Errors
-/// [`GpuError::TooLarge`] when `visibility` has fewer layers than lights; the technique's
-/// errors.
-pub fn render_visibility(
-    gpu: &Gpu,
-    technique: &dyn ShadowTechnique,
+/// Why a light got no shadow pass, or `None` when it needs one: no visible receiver faces it,
+/// or `negligible` marks it (Weber's law).
+fn skip_reason(receivers: &Receivers, light: &LightShape, negligible: bool) -> Option<String> {
+    if !receivers.any_faces(light) {
+        return Some("no visible receiver faces it".into());
+    }
+    negligible.then(|| {
+        format!(
+            "under Weber's {:.0} % of every visible receiver's light, with the others skipped",
+            WEBER_FRACTION * 100.0
+        )
+    })
+}
+
+/// The frame loop: `shadow(k, light)` for every light that needs a pass, a skip report for
+/// the others.
+fn each_light(
     receivers: &Receivers,
     lights: &[LightShape],
     negligible: &[bool],
     visibility: &Visibility,
+    mut shadow: impl FnMut(u32, &LightShape) -> Result<ShadowPassReport, GpuError>,
 ) -> Result<Vec<ShadowPassReport>, GpuError> {
     if lights.len() as u64 > u64::from(visibility.layers()) {
         return Err(GpuError::TooLarge {
@@ -190,26 +227,52 @@ pub fn render_visibility(
     }
     let mut out = Vec::with_capacity(lights.len());
     for (k, light) in lights.iter().enumerate() {
-        if !receivers.any_faces(light) {
-            out.push(ShadowPassReport {
-                skipped: Some("no visible receiver faces it".into()),
-                ..ShadowPassReport::default()
-            });
-            continue;
+        match skip_reason(receivers, light, negligible.get(k).copied().unwrap_or(false)) {
+            Some(why) => out.push(ShadowPassReport { skipped: Some(why), ..ShadowPassReport::default() }),
+            None => out.push(shadow(k as u32, light)?),
         }
-        if negligible.get(k).copied().unwrap_or(false) {
-            out.push(ShadowPassReport {
-                skipped: Some(format!(
-                    "under Weber's {:.0} % of every visible receiver's light, with the others skipped",
-                    WEBER_FRACTION * 100.0
-                )),
-                ..ShadowPassReport::default()
-            });
-            continue;
-        }
-        out.push(technique.write_visibility(gpu, receivers, light, &visibility.layer(k as u32))?);
     }
     Ok(out)
+}
+
+/// Records every light's layer of `visibility` with `technique` into `encoder`, skipping
+/// lights that no visible receiver faces and lights marked in `negligible` (e.g. by
+/// [`weber_negligible`]; an empty slice marks none). Skipped lights' layers are left as they
+/// are: clear `visibility` to lit first ([`Visibility::record_clear`]).
+///
+/// # Errors
+/// [`GpuError::TooLarge`] when `visibility` has fewer layers than lights; the technique's
+/// errors.
+pub fn record_visibility(
+    gpu: &Gpu,
+    encoder: &mut wgpu::CommandEncoder,
+    technique: &dyn ShadowTechnique,
+    receivers: &Receivers,
+    lights: &[LightShape],
+    negligible: &[bool],
+    visibility: &Visibility,
+) -> Result<Vec<ShadowPassReport>, GpuError> {
+    each_light(receivers, lights, negligible, visibility, |k, light| {
+        technique.record(gpu, encoder, receivers, light, &visibility.layer(k))
+    })
+}
+
+/// As [`record_visibility`], each light in a submission of its own, waited for and timed
+/// ([`ShadowTechnique::write_visibility`]): per-light GPU times for validate and the trade.
+///
+/// # Errors
+/// As [`record_visibility`]; GPU failures.
+pub fn render_visibility(
+    gpu: &Gpu,
+    technique: &dyn ShadowTechnique,
+    receivers: &Receivers,
+    lights: &[LightShape],
+    negligible: &[bool],
+    visibility: &Visibility,
+) -> Result<Vec<ShadowPassReport>, GpuError> {
+    each_light(receivers, lights, negligible, visibility, |k, light| {
+        technique.write_visibility(gpu, receivers, light, &visibility.layer(k))
+    })
 }
 
 /// Weber's fraction: a change of luminance below 2 % of what a surface already receives is not
@@ -374,9 +437,10 @@ impl ShadowTechnique for PrecomputedVisibility {
         self.layers.iter().any(|(l, _)| l == light)
     }
 
-    fn write_visibility(
+    fn record(
         &self,
         gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
         receivers: &Receivers,
         light: &LightShape,
         target: &wgpu::TextureView,
@@ -407,7 +471,7 @@ impl ShadowTechnique for PrecomputedVisibility {
                 wgpu::BindGroupEntry { binding: 1, resource: values.as_entire_binding() },
             ],
         });
-        crate::fullscreen::draw(gpu, &self.pipeline, &bind, target, wgpu::Color::WHITE)?;
+        crate::fullscreen::record(encoder, &self.pipeline, &bind, target, wgpu::LoadOp::Clear(wgpu::Color::WHITE));
         Ok(ShadowPassReport::default())
     }
 }

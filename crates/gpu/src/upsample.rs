@@ -80,14 +80,33 @@ impl UpsamplePass {
     }
 
     /// `base` + `low` upsampled: `low` was shaded from `low_gb`, whose size is `high_gb`'s
-    /// divided by an integer factor. Returns a new full-resolution HDR texture.
+    /// divided by an integer factor. Returns a new full-resolution HDR texture, waited for.
     ///
     /// # Errors
-    /// [`GpuError::Failed`] for sizes that are not an integer factor apart, a non-positive
-    /// sigma or a radius over [`JointBilateral::MAX_RADIUS`]; GPU failures.
+    /// As [`UpsamplePass::record`]; GPU failures.
     pub fn render(
         &self,
         gpu: &Gpu,
+        geometry: &SceneGeometry,
+        low: (&GBuffer, &wgpu::Texture),
+        high: (&GBuffer, &wgpu::Texture),
+        settings: &JointBilateral,
+    ) -> Result<wgpu::Texture, GpuError> {
+        let mut encoder = gpu.encoder("upsample");
+        let output = self.record(gpu, &mut encoder, geometry, low, high, settings)?;
+        gpu.submit_and_wait(encoder)?;
+        Ok(output)
+    }
+
+    /// Records [`UpsamplePass::render`] into `encoder` without submitting.
+    ///
+    /// # Errors
+    /// [`GpuError::Failed`] for sizes that are not an integer factor apart, a non-positive
+    /// sigma or a radius over [`JointBilateral::MAX_RADIUS`]; an image beyond the limits.
+    pub fn record(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
         geometry: &SceneGeometry,
         (low_gb, low): (&GBuffer, &wgpu::Texture),
         (high_gb, base): (&GBuffer, &wgpu::Texture),
@@ -145,13 +164,13 @@ impl UpsamplePass {
             entries: &entries,
         });
         let output = crate::target::render_target(gpu, "upsampled", (hw, hh, 1), crate::shade::HDR_FORMAT)?;
-        crate::fullscreen::draw(
-            gpu,
+        crate::fullscreen::record(
+            encoder,
             &self.pipeline,
             &bind,
             &output.create_view(&Default::default()),
-            wgpu::Color::BLACK,
-        )?;
+            wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+        );
         Ok(output)
     }
 }

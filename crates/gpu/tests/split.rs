@@ -24,9 +24,10 @@ impl ShadowTechnique for Unshadowed {
         true
     }
 
-    fn write_visibility(
+    fn record(
         &self,
         _: &Gpu,
+        _: &mut wgpu::CommandEncoder,
         _: &Receivers,
         _: &LightShape,
         _: &wgpu::TextureView,
@@ -54,16 +55,17 @@ impl ShadowTechnique for Stripes {
         true
     }
 
-    fn write_visibility(
+    fn record(
         &self,
         gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
         receivers: &Receivers,
         light: &LightShape,
         target: &wgpu::TextureView,
     ) -> Result<ShadowPassReport, GpuError> {
         let values = receivers.points.iter().map(|(p, _)| if p.is_finite() { Self::at(*p) } else { 1.0 }).collect();
         gpu::PrecomputedVisibility::new(gpu, "stripes", receivers.gbuffer.size(), vec![(*light, values)])?
-            .write_visibility(gpu, receivers, light, target)
+            .record(gpu, encoder, receivers, light, target)
     }
 }
 

@@ -20,6 +20,7 @@
 //! let light = LightShape::Distant { direction: glam::Vec3::new(0.3, 1.0, 0.2).normalize(), half_angle: 0.05 };
 //! let vis = gpu::Visibility::new(&gpu, 640, 480, 1).expect("fits");
 //! let report = wedges.write_visibility(&gpu, &Receivers::new(&gbuffer, &points), &light, &vis.layer(0));
+//! // or, in a renderer's frame: wedges.record(&gpu, &mut encoder, &receivers, &light, &layer)
 //! ```
 
 pub mod casters;
@@ -31,6 +32,7 @@ use geometry::reach_along;
 use glam::{Mat4, Vec3};
 use gpu::accumulate::{Accumulator, ResolvePass};
 use gpu::{Gpu, GpuError, LightShape, Receivers, ShadowPassReport, ShadowTechnique};
+use std::cell::RefCell;
 use wgpu::util::DeviceExt;
 
 /// How wedges reach the pixels they cover.
@@ -152,6 +154,17 @@ pub struct Wedges {
     resolve: ResolvePass,
     // the resolve's edge sum where the raster path leaves it in the accumulator
     no_edge_sum: wgpu::Texture,
+    // screen-sized targets reused from light to light (passes recorded in order), per size
+    scratch: RefCell<Option<Scratch>>,
+}
+
+/// A light's screen-sized scratch targets.
+#[derive(Clone)]
+struct Scratch {
+    size: (u32, u32),
+    accumulator: Accumulator,
+    // the compute path's edge sum (1 x 1 on the raster path)
+    edge_sum: wgpu::Texture,
 }
 
 /// The WGSL library of this crate's shaders (`// requires:` names).
@@ -189,6 +202,16 @@ fn edge_sum_texture(gpu: &Gpu, (w, h): (u32, u32)) -> wgpu::Texture {
     })
 }
 
+/// The box around every caster's bounding sphere.
+fn casters_bounds(casters: &Casters) -> (Vec3, Vec3) {
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for c in &casters.casters {
+        lo = lo.min(c.bounds.0 - Vec3::splat(c.bounds.1));
+        hi = hi.max(c.bounds.0 + Vec3::splat(c.bounds.1));
+    }
+    (lo, hi)
+}
+
 /// Whether the segment from `a` to `b` meets the box `(lo, hi)`.
 fn segment_meets_box(a: Vec3, b: Vec3, bounds: (Vec3, Vec3)) -> bool {
     geometry::box_interval(a, b - a, bounds).is_some_and(|(t0, _)| t0 <= 1.0)
@@ -219,11 +242,7 @@ impl Wedges {
     #[must_use]
     pub fn new(gpu: &Gpu, scene: &scene::Scene, settings: WedgeSettings) -> Self {
         let casters = Casters::new(scene);
-        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-        for c in &casters.casters {
-            lo = lo.min(c.bounds.0 - Vec3::splat(c.bounds.1));
-            hi = hi.max(c.bounds.0 + Vec3::splat(c.bounds.1));
-        }
+        let (lo, hi) = casters_bounds(&casters);
         let module = |label, src| gpu::shader::module(&gpu.device, label, src, LIBRARY);
         let volume_module = module("shadow volume", include_str!("../../../shaders/penumbra-wedge/volume.wgsl"));
         let wedge_module = module("wedges", include_str!("../../../shaders/penumbra-wedge/wedge.wgsl"));
@@ -285,7 +304,43 @@ impl Wedges {
             cache: None,
         });
         let no_edge_sum = edge_sum_texture(gpu, (1, 1));
-        Self { casters, bounds: (lo, hi), settings, volume, wedge, tiles, resolve, no_edge_sum }
+        Self {
+            casters,
+            bounds: (lo, hi),
+            settings,
+            volume,
+            wedge,
+            tiles,
+            resolve,
+            no_edge_sum,
+            scratch: RefCell::new(None),
+        }
+    }
+
+    /// The scratch targets for images of `size`, made when the size changes.
+    fn scratch(&self, gpu: &Gpu, size: (u32, u32)) -> Result<Scratch, GpuError> {
+        let mut cached = self.scratch.borrow_mut();
+        if let Some(s) = cached.as_ref().filter(|s| s.size == size) {
+            return Ok(s.clone());
+        }
+        let edge_size = if self.settings.path == WedgePath::Compute { size } else { (1, 1) };
+        let s = Scratch { size, accumulator: Accumulator::new(gpu, size)?, edge_sum: edge_sum_texture(gpu, edge_size) };
+        *cached = Some(s.clone());
+        Ok(s)
+    }
+
+    /// Moves object `object` to its mesh in `scene` (a new pose): its caster is welded again
+    /// from the moved positions, on the CPU, as [`Wedges::new`] would; no GPU object is made.
+    ///
+    /// # Errors
+    /// [`GpuError::Failed`] for an object out of range.
+    pub fn update_object(&mut self, scene: &scene::Scene, object: usize) -> Result<(), GpuError> {
+        let (Some(slot), Some(o)) = (self.casters.casters.get_mut(object), scene.objects.get(object)) else {
+            return Err(GpuError::Failed(format!("wedges: no object {object}")));
+        };
+        *slot = Caster::new(&o.name, &o.mesh.positions, &o.mesh.indices);
+        self.bounds = casters_bounds(&self.casters);
+        Ok(())
     }
 
     /// The casters (which are closed, which cast as sheets).
@@ -396,9 +451,10 @@ impl ShadowTechnique for Wedges {
         true
     }
 
-    fn write_visibility(
+    fn record(
         &self,
         gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
         receivers: &Receivers,
         light: &LightShape,
         target: &wgpu::TextureView,
@@ -467,7 +523,8 @@ impl ShadowTechnique for Wedges {
                 wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&normal) },
             ],
         });
-        let acc = Accumulator::new(gpu, gb.size())?;
+        let scratch = self.scratch(gpu, gb.size())?;
+        let acc = &scratch.accumulator;
         let compute = (self.settings.path == WedgePath::Compute).then(|| {
             let (w, h) = gb.size();
             let bins = bin_footprints(&plan.footprints, (w, h));
@@ -476,7 +533,7 @@ impl ShadowTechnique for Wedges {
             if groups.is_empty() {
                 groups.push([0, 0]);
             }
-            let sum = edge_sum_texture(gpu, (w, h));
+            let sum = scratch.edge_sum.clone();
             let sum_view = sum.create_view(&Default::default());
             let tiles_buf = buffer("wedge tiles", bytemuck::cast_slice(&tiles), wgpu::BufferUsages::UNIFORM);
             let ranges_buf =
@@ -498,7 +555,7 @@ impl ShadowTechnique for Wedges {
             });
             (sum, bind, (bins.tiles_x, h.div_ceil(TILE).max(1)))
         });
-        let (time, clock) = gpu.measure(|encoder| {
+        {
             {
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("wedges"),
@@ -530,11 +587,11 @@ impl ShadowTechnique for Wedges {
             let sum = compute.as_ref().map_or(&self.no_edge_sum, |(t, _, _)| t).create_view(&Default::default());
             let extra =
                 [(3, wgpu::BindingResource::TextureView(&normal)), (4, wgpu::BindingResource::TextureView(&sum))];
-            self.resolve.record(gpu, encoder, gb, &acc, bytemuck::cast_slice(&light_params), &extra, target);
-        })?;
+            self.resolve.record(gpu, encoder, gb, acc, bytemuck::cast_slice(&light_params), &extra, target);
+        }
         Ok(ShadowPassReport {
-            time,
-            clock: Some(clock),
+            time: std::time::Duration::ZERO,
+            clock: None,
             skipped: None,
             primitives: (plan.volume.len() + plan.footprints.len()) as u64,
             culled: plan.culled,

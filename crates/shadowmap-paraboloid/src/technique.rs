@@ -7,6 +7,7 @@ use crate::{ShadowLight, ShadowSettings, Technique, shadow_triangles};
 use glam::Vec3;
 use gpu::accumulate::{Accumulator, ResolvePass};
 use gpu::{Gpu, GpuError, LightShape, Receivers, ShadowGeometry, ShadowPassReport, ShadowTechnique};
+use std::cell::RefCell;
 use std::rc::Rc;
 use std::time::Duration;
 
@@ -17,14 +18,26 @@ pub struct MapTechnique {
     technique: Technique,
     settings: ShadowSettings,
     samples: u32,
+    scratch: RefCell<Option<Scratch>>,
 }
 
 /// What every setting of a scene's maps shares: pipelines and geometry.
 struct Shared {
     mapper: ShadowMapper,
-    triangles: Vec<[Vec3; 3]>,
-    geometry: ShadowGeometry,
+    // the scene's triangles and their chunks, updated in place when an object moves
+    triangles: RefCell<Vec<[Vec3; 3]>>,
+    geometry: RefCell<ShadowGeometry>,
+    // per object, its first triangle in `triangles` and its triangle count
+    objects: Vec<(usize, usize)>,
     resolve: ResolvePass,
+}
+
+/// A setting's scratch targets, reused from light to light (passes recorded in order).
+#[derive(Clone)]
+struct Scratch {
+    key: ((u32, u32), (u32, u32), bool),
+    map: wgpu::Texture,
+    accumulator: Option<Accumulator>,
 }
 
 /// `n` directions spread over the cone of half-angle `half_angle` about `axis`, uniform in
@@ -63,14 +76,74 @@ impl MapTechnique {
     ) -> Result<Self, GpuError> {
         let triangles = gpu::scene_triangles(scene);
         let geometry = ShadowGeometry::upload(gpu, &triangles, ShadowGeometry::CHUNK_TRIANGLES)?;
-        let shared = Shared { mapper: ShadowMapper::new(gpu), triangles, geometry, resolve: ResolvePass::new(gpu) };
-        Ok(Self { shared: Rc::new(shared), technique, settings, samples: samples.max(1) })
+        let mut first = 0;
+        let objects = scene
+            .objects
+            .iter()
+            .map(|o| {
+                let range = (first, o.mesh.indices.len());
+                first += o.mesh.indices.len();
+                range
+            })
+            .collect();
+        let shared = Shared {
+            mapper: ShadowMapper::new(gpu),
+            triangles: RefCell::new(triangles),
+            geometry: RefCell::new(geometry),
+            objects,
+            resolve: ResolvePass::new(gpu),
+        };
+        Ok(Self { shared: Rc::new(shared), technique, settings, samples: samples.max(1), scratch: RefCell::new(None) })
     }
 
     /// Another setting on the same scene, sharing this one's pipelines and geometry.
     #[must_use]
     pub fn variant(&self, technique: Technique, settings: ShadowSettings, samples: u32) -> Self {
-        Self { shared: Rc::clone(&self.shared), technique, settings, samples: samples.max(1) }
+        Self {
+            shared: Rc::clone(&self.shared),
+            technique,
+            settings,
+            samples: samples.max(1),
+            scratch: RefCell::new(None),
+        }
+    }
+
+    /// Moves object `object` to its mesh in `scene` (same triangles, new positions: a pose
+    /// change) without building anything: its triangles are written into the shadow geometry
+    /// with `queue.write_buffer` and their chunks' bounds recomputed. Every variant sharing
+    /// this one's geometry sees the new pose.
+    ///
+    /// # Errors
+    /// [`GpuError::Failed`] for an object out of range or with another triangle count.
+    pub fn update_object(&self, gpu: &Gpu, scene: &scene::Scene, object: usize) -> Result<(), GpuError> {
+        let (first, count) = self.shared.objects.get(object).copied().unwrap_or((0, usize::MAX));
+        let mesh = scene.objects.get(object).map(|o| &o.mesh);
+        let Some(mesh) = mesh.filter(|m| m.indices.len() == count) else {
+            return Err(GpuError::Failed(format!(
+                "shadow maps: object {object} is not the same mesh with new positions (triangles {:?}, had {count})",
+                mesh.map(|m| m.indices.len())
+            )));
+        };
+        let moved: Vec<[Vec3; 3]> = (0..count).map(|t| mesh.triangle(t)).collect();
+        self.shared.triangles.borrow_mut()[first..first + count].copy_from_slice(&moved);
+        self.shared.geometry.borrow_mut().update(gpu, first, &moved)
+    }
+
+    /// The scratch targets for `size` images, `map` (resolution, layers) maps and an
+    /// accumulator when `accumulate`; made when one of them changes.
+    fn scratch(&self, gpu: &Gpu, size: (u32, u32), map: (u32, u32), accumulate: bool) -> Result<Scratch, GpuError> {
+        let key = (size, map, accumulate);
+        let mut cached = self.scratch.borrow_mut();
+        if let Some(s) = cached.as_ref().filter(|s| s.key == key) {
+            return Ok(s.clone());
+        }
+        let s = Scratch {
+            key,
+            map: gpu::render_target(gpu, "shadow map", (map.0, map.0, map.1), crate::mapper::DEPTH_FORMAT)?,
+            accumulator: accumulate.then(|| Accumulator::new(gpu, size)).transpose()?,
+        };
+        *cached = Some(s.clone());
+        Ok(s)
     }
 
     /// The shadow mapper (its pipelines).
@@ -100,9 +173,10 @@ impl ShadowTechnique for MapTechnique {
         }
     }
 
-    fn write_visibility(
+    fn record(
         &self,
         gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
         receivers: &Receivers,
         light: &LightShape,
         target: &wgpu::TextureView,
@@ -121,46 +195,36 @@ impl ShadowTechnique for MapTechnique {
             ),
             LightShape::Sphere { center, .. } => (vec![ShadowLight::omni(center)], 0.0),
         };
+        let shared = &self.shared;
         let subdivided;
+        let triangles = shared.triangles.borrow();
+        let geometry = shared.geometry.borrow();
         let geometry = if self.technique == Technique::DualParaboloid && settings.subdivide_angle.is_some() {
-            let t = shadow_triangles(&self.shared.triangles, &lights[0], self.technique, &settings);
+            let t = shadow_triangles(&triangles, &lights[0], self.technique, &settings);
             subdivided = ShadowGeometry::upload(gpu, &t, ShadowGeometry::CHUNK_TRIANGLES)?;
             &subdivided
         } else {
-            &self.shared.geometry
+            &*geometry
         };
-        let mut time = Duration::ZERO;
-        let mut clock = None;
         let mut primitives = 0u64;
-        let acc = if lights.len() > 1 { Some(Accumulator::new(gpu, receivers.gbuffer.size())?) } else { None };
+        let size = receivers.gbuffer.size();
+        let layers = ShadowMapper::view_count(&lights[0], self.technique);
+        let scratch = self.scratch(gpu, size, (settings.resolution, layers), lights.len() > 1)?;
         for (k, l) in lights.iter().enumerate() {
-            let map = self.shared.mapper.render(gpu, geometry, l, self.technique, &settings)?;
+            // one map texture for all of them: the passes run in the order recorded
+            let map =
+                shared.mapper.record(gpu, encoder, geometry, l, self.technique, &settings, Some((&scratch.map, 0)))?;
             primitives += u64::from(map.triangles_drawn());
-            let out = match &acc {
+            let out = match &scratch.accumulator {
                 Some(a) => VisibilityTarget::Add(a, k == 0),
                 None => VisibilityTarget::Layer(target),
             };
-            let (t, c) = gpu.measure(|encoder| {
-                self.shared.mapper.record_visibility(gpu, encoder, &map, receivers.gbuffer, out, half_angle);
-            })?;
-            time += map.time + t;
-            clock = Some(c);
+            shared.mapper.record_visibility(gpu, encoder, &map, receivers.gbuffer, out, half_angle);
         }
-        if let Some(a) = &acc {
-            let (t, _) = gpu.measure(|encoder| {
-                let scale = [1.0 / lights.len() as f32, 0.0, 0.0, 0.0];
-                self.shared.resolve.record(
-                    gpu,
-                    encoder,
-                    receivers.gbuffer,
-                    a,
-                    bytemuck::cast_slice(&scale),
-                    &[],
-                    target,
-                );
-            })?;
-            time += t;
+        if let Some(a) = &scratch.accumulator {
+            let scale = [1.0 / lights.len() as f32, 0.0, 0.0, 0.0];
+            shared.resolve.record(gpu, encoder, receivers.gbuffer, a, bytemuck::cast_slice(&scale), &[], target);
         }
-        Ok(ShadowPassReport { time, clock, skipped: None, primitives, culled: Vec::new() })
+        Ok(ShadowPassReport { time: Duration::ZERO, clock: None, skipped: None, primitives, culled: Vec::new() })
     }
 }

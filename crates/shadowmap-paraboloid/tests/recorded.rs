@@ -1,0 +1,125 @@
+//! The real-time path: every light recorded into one encoder (no submission, wait, mapping or
+//! pipeline while recording; one map texture and one accumulator reused from light to light)
+//! writes exactly the layers that each light waited for in a submission of its own writes; and
+//! an object moved with `MapTechnique::update_object` shadows bit for bit as maps built afresh
+//! for its new pose.
+
+use glam::Vec3;
+use gpu::{GBufferPass, Gpu, LightShape, Receivers, SceneGeometry, Visibility, record_visibility, render_visibility};
+use shadowmap_paraboloid::{MapTechnique, ShadowSettings, Technique};
+
+fn scene() -> scene::Scene {
+    let mut s = scene::Scene::builtin("spheres_box").unwrap();
+    (s.camera.width, s.camera.height) = (96, 72);
+    s
+}
+
+fn distant() -> Vec<LightShape> {
+    vec![
+        LightShape::Distant { direction: Vec3::new(0.3, 1.0, 0.2).normalize(), half_angle: 0.02 },
+        LightShape::Distant { direction: Vec3::new(-0.6, 0.8, 0.4).normalize(), half_angle: 0.2 },
+        LightShape::Distant { direction: Vec3::new(0.7, 0.4, -0.5).normalize(), half_angle: 0.1 },
+    ]
+}
+
+fn local() -> Vec<LightShape> {
+    vec![
+        LightShape::Sphere { center: Vec3::new(0.5, 3.0, 1.0), radius: 0.0 },
+        LightShape::Sphere { center: Vec3::new(-1.5, 2.0, 0.5), radius: 0.0 },
+    ]
+}
+
+fn settings() -> ShadowSettings {
+    ShadowSettings { resolution: 256, pcf_radius: 1, ..ShadowSettings::default() }
+}
+
+fn recorded(
+    gpu: &Gpu,
+    t: &MapTechnique,
+    receivers: &Receivers,
+    lights: &[LightShape],
+) -> (Vec<Vec<f32>>, gpu::GpuCounters) {
+    let (w, h) = receivers.gbuffer.size();
+    let vis = Visibility::allocate(gpu, w, h, lights.len() as u32).unwrap();
+    let mut encoder = gpu.encoder("all lights");
+    let before = gpu.counters();
+    vis.record_clear(&mut encoder);
+    let reports = record_visibility(gpu, &mut encoder, t, receivers, lights, &[], &vis).unwrap();
+    let during = gpu.counters() - before;
+    assert!(reports.iter().all(|r| r.skipped.is_none() && r.primitives > 0));
+    gpu.submit(encoder);
+    ((0..lights.len() as u32).map(|k| vis.read(gpu, k).unwrap()).collect(), during)
+}
+
+fn waited(gpu: &Gpu, t: &MapTechnique, receivers: &Receivers, lights: &[LightShape]) -> Vec<Vec<f32>> {
+    let (w, h) = receivers.gbuffer.size();
+    let vis = Visibility::new(gpu, w, h, lights.len() as u32).unwrap();
+    render_visibility(gpu, t, receivers, lights, &[], &vis).unwrap();
+    (0..lights.len() as u32).map(|k| vis.read(gpu, k).unwrap()).collect()
+}
+
+#[test]
+fn all_lights_recorded_in_one_encoder_equal_each_light_waited_for() {
+    let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
+    let scene = scene();
+    let geometry = SceneGeometry::upload(&gpu, &scene).unwrap();
+    let gb = GBufferPass::new(&gpu).render(&gpu, &geometry, &scene.camera).unwrap();
+    let points = gb.read_points(&gpu).unwrap();
+    let receivers = Receivers::new(&gb, &points);
+    let ortho = MapTechnique::new(&gpu, &scene, Technique::Orthographic, settings(), 1).unwrap();
+    let cases = [
+        (ortho.variant(Technique::Orthographic, settings(), 1), distant()),
+        // four maps a light into one accumulator
+        (ortho.variant(Technique::Orthographic, settings(), 4), distant()),
+        (ortho.variant(Technique::Cube, settings(), 1), local()),
+        (ortho.variant(Technique::DualParaboloid, settings(), 1), local()),
+    ];
+    for (technique, lights) in &cases {
+        let name = gpu::ShadowTechnique::name(technique);
+        let (layers, during) = recorded(&gpu, technique, &receivers, lights);
+        assert_eq!(
+            (during.submits, during.waits, during.readback_bytes, during.pipelines),
+            (0, 0, 0, 0),
+            "{name}: recording submitted, waited, mapped or built"
+        );
+        let reference = waited(&gpu, technique, &receivers, lights);
+        for (k, (a, b)) in layers.iter().zip(&reference).enumerate() {
+            assert!(a == b, "{name}, light {k}: recorded and waited layers differ");
+            assert!(a.iter().any(|v| *v < 0.5) && a.iter().any(|v| *v > 0.5), "{name}, light {k}: no shadow edge");
+        }
+    }
+}
+
+#[test]
+fn a_moved_object_shadows_as_maps_built_for_its_pose() {
+    let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
+    let rest = scene();
+    let object = rest.objects.iter().position(|o| o.name != "ground").unwrap();
+    let mut moved = rest.clone();
+    for p in &mut moved.objects[object].mesh.positions {
+        *p += Vec3::new(0.31, 0.0, -0.17);
+    }
+    let geometry = SceneGeometry::upload(&gpu, &moved).unwrap();
+    let gb = GBufferPass::new(&gpu).render(&gpu, &geometry, &moved.camera).unwrap();
+    let points = gb.read_points(&gpu).unwrap();
+    let receivers = Receivers::new(&gb, &points);
+    let updated = MapTechnique::new(&gpu, &rest, Technique::Orthographic, settings(), 1).unwrap();
+    // a variant shares the geometry: it sees the move too
+    let cube = updated.variant(Technique::Cube, settings(), 1);
+    let at_rest = recorded(&gpu, &updated, &receivers, &distant()).0;
+    let before = gpu.counters();
+    updated.update_object(&gpu, &moved, object).unwrap();
+    let d = gpu.counters() - before;
+    assert_eq!((d.submits, d.waits, d.pipelines), (0, 0, 0), "moving submitted, waited or built");
+    let fresh = MapTechnique::new(&gpu, &moved, Technique::Orthographic, settings(), 1).unwrap();
+    let a = recorded(&gpu, &updated, &receivers, &distant()).0;
+    assert!(a == recorded(&gpu, &fresh, &receivers, &distant()).0, "updated maps differ from maps built for the pose");
+    assert!(a != at_rest, "the shadows did not move with the object");
+    let fresh_cube = fresh.variant(Technique::Cube, settings(), 1);
+    assert!(recorded(&gpu, &cube, &receivers, &local()).0 == recorded(&gpu, &fresh_cube, &receivers, &local()).0);
+    // another mesh, or no such object: refused
+    let mut other = moved.clone();
+    other.objects[object].mesh.indices.pop();
+    assert!(updated.update_object(&gpu, &other, object).is_err());
+    assert!(updated.update_object(&gpu, &moved, moved.objects.len()).is_err());
+}
