@@ -6,9 +6,10 @@
 
 use envmap_sphere::EnvMap;
 use gpu::{
-    Background, GBufferPass, Gpu, GpuError, JointBilateral, LightShape, PointsRead, PrefilterSettings, Receivers,
-    SceneGeometry, ShadeLight, ShadingPass, ShadowTechnique, SpecularAmbient, SplitFrame, SplitPasses, SplitSettings,
-    UpsamplePass, Visibility, WEBER_FRACTION, indirect_camera, record_split, record_visibility, weber_negligible,
+    Background, GBufferPass, Gpu, GpuError, JointBilateral, LightShape, PendingStats, PrefilterSettings,
+    ReceiverReduction, Receivers, SceneGeometry, ShadeLight, ShadingPass, ShadowTechnique, SpecularAmbient, SplitFrame,
+    SplitPasses, SplitSettings, UpsamplePass, Visibility, WEBER_FRACTION, WeberInput, indirect_camera, record_split,
+    record_visibility,
 };
 use light_extract::Decomposition;
 use penumbra_wedge::{WedgeSettings, Wedges};
@@ -63,6 +64,8 @@ pub struct Frame {
     specular: SpecularAmbient,
     wedges: Wedges,
     maps: MapTechnique,
+    // the receivers of the full- and the low-resolution G-buffer
+    reductions: [ReceiverReduction; 2],
 }
 
 impl Frame {
@@ -95,6 +98,7 @@ impl Frame {
             specular: SpecularAmbient::new(gpu, &decomposition.ambient, &PrefilterSettings::default()).map_err(e)?,
             wedges: Wedges::new(gpu, &scene, WedgeSettings::default()),
             maps: MapTechnique::new(gpu, &scene, Technique::Orthographic, maps_settings(), 1).map_err(e)?,
+            reductions: [ReceiverReduction::new(gpu), ReceiverReduction::new(gpu)],
             rest: scene.clone(),
             scene,
             decomposition,
@@ -123,9 +127,10 @@ impl Frame {
     }
 
     /// Renders one frame with the EnvIndirects at 1 / `scale` and returns the image, its work
-    /// submitted and not waited for. Two submissions: the G-buffers with the copies of their
-    /// points, mapped back (one wait: the receivers are still computed on the CPU), then
-    /// everything else recorded into one encoder.
+    /// submitted and not waited for. Two submissions: the G-buffers with their receivers
+    /// reduced on the GPU (bounds, focus, the lights they face, Weber's test), whose few hundred
+    /// bytes are mapped back (one wait: the wedges' plans and the maps' matrices are still made
+    /// on the CPU), then everything else recorded into one encoder.
     ///
     /// # Errors
     /// GPU failures; a scale that does not divide the size.
@@ -136,25 +141,27 @@ impl Frame {
         let directs = d.directs();
         let settings = SplitSettings { indirect_scale: scale, upsample: JointBilateral::PAPER };
         let low_camera = indirect_camera(&self.scene.camera, &settings)?;
+        let weber = WeberInput { lights: &lights, ambient: Some(&d.ambient_sh), fraction: WEBER_FRACTION };
         let mut encoder = gpu.encoder("frame g-buffers");
         let gb = self.gbuffer.record(gpu, &mut encoder, &self.geometry, &self.scene.camera)?;
         let low_gb =
             (scale != 1).then(|| self.gbuffer.record(gpu, &mut encoder, &self.geometry, &low_camera)).transpose()?;
-        let mut reads = vec![gb.record_points(gpu, &mut encoder)?];
+        let mut pending = vec![self.reductions[0].record(gpu, &mut encoder, &gb, &shapes, Some(weber))?];
         if let Some(l) = &low_gb {
-            reads.push(l.record_points(gpu, &mut encoder)?);
+            pending.push(self.reductions[1].record(gpu, &mut encoder, l, &shapes, Some(weber))?);
         }
         gpu.submit(encoder);
-        let points = PointsRead::finish_all(gpu, reads)?;
-        let receivers = Receivers::new(&gb, &points[0]);
-        let low_receivers = low_gb.as_ref().map(|l| Receivers::new(l, &points[1]));
+        let stats = PendingStats::read_all(gpu, pending)?;
+        let receivers = Receivers::from_stats(&gb, &stats[0], &shapes);
+        let low_receivers = low_gb.as_ref().map(|l| Receivers::from_stats(l, &stats[1], &shapes));
         let low = low_receivers.as_ref().unwrap_or(&receivers);
+        let low_negligible = &stats[stats.len() - 1].negligible;
+        let negligible = &stats[0].negligible;
 
         let mut encoder = gpu.encoder("frame");
         let (w, h) = gb.size();
         let vis = Visibility::allocate(gpu, w, h, directs as u32)?;
         vis.record_clear(&mut encoder);
-        let negligible = weber_negligible(&receivers, &lights, Some(&d.ambient_sh), WEBER_FRACTION);
         let wedges: &dyn ShadowTechnique = &self.wedges;
         record_visibility(gpu, &mut encoder, wedges, &receivers, &shapes[..directs], &negligible[..directs], &vis)?;
         let split = record_split(
@@ -163,7 +170,7 @@ impl Frame {
             &SplitPasses { gbuffer: &self.gbuffer, shading: &self.shading, upsample: &self.upsample },
             &self.geometry,
             (&receivers, &vis),
-            low,
+            (low, Some(low_negligible)),
             &SplitFrame {
                 lights: &lights,
                 shapes: &shapes,

@@ -202,14 +202,14 @@ fn frame_json_counts_what_a_moving_frame_costs() {
     for k in ["submits_per_frame", "waits_per_frame", "readback_bytes_per_frame", "cpu_record_ms", "wall_ms"] {
         assert!(v[k].as_f64().is_some_and(|x| x.is_finite() && x >= 0.0), "{k}: {v}");
     }
-    // the recorded frame: the G-buffers' submission (with the points' copies) and the frame's;
-    // the points' wait and the harness's at the frame's end; nothing built after the first frame
+    // the recorded frame: the G-buffers' submission (with their receivers reduced) and the
+    // frame's; the reduction's wait and the harness's at the frame's end; nothing built after
+    // the first frame
     assert_eq!(v["submits_per_frame"].as_f64(), Some(2.0), "{v}");
     assert_eq!(v["waits_per_frame"].as_f64(), Some(2.0), "{v}");
     assert_eq!(v["pipelines_created_after_first_frame"].as_u64(), Some(0), "{v}");
-    // at most the two G-buffers' points (32 bytes a pixel; the rows of 64 and 32 pixels need no padding)
-    let points = 32.0 * (64.0 * 48.0 + 32.0 * 24.0);
-    assert!(v["readback_bytes_per_frame"].as_f64().is_some_and(|b| b <= points), "{v}");
+    // the receivers' statistics, not their points: at most the 4 KiB
+    assert!(v["readback_bytes_per_frame"].as_f64().is_some_and(|b| b > 0.0 && b <= 4096.0), "{v}");
     assert!(v["gpu_ms"].is_null() || v["gpu_ms"].as_f64().is_some_and(|g| g >= 0.0), "{v}");
     assert!(v["adapter"].as_str().is_some_and(|a| !a.is_empty()), "{v}");
     let out = xtask(&["frame", "--json", "--scale", "3", "--size", "64x48"]);

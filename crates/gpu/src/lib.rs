@@ -19,6 +19,7 @@ mod gbuffer;
 mod geometry;
 mod interleave;
 mod readback;
+mod receivers;
 mod shade;
 pub mod shader;
 mod split;
@@ -37,6 +38,7 @@ pub use gbuffer::{
 pub use geometry::{Chunk, SceneGeometry, ShadowGeometry, scene_triangles};
 pub use interleave::{InterleavePass, InterleavedFrame, MAX_SETS, interleave_set, interleave_tile, render_interleaved};
 pub use readback::{PendingRead, read_buffer, read_mapped, read_mapped_all, read_texture_f32, read_texture_rgba};
+pub use receivers::{PendingStats, ReceiverReduction, ReceiverStats, WeberInput};
 pub use shade::{Background, HDR_FORMAT, ShadeLight, ShadeParams, ShadingPass, Visibility, read_hdr};
 pub use split::{SplitFrame, SplitImage, SplitPasses, SplitSettings, indirect_camera, record_split, render_split};
 pub use supersample::RotatedGrid;

@@ -115,7 +115,7 @@ pub fn render_split(
         passes,
         geometry,
         (receivers, direct_visibility),
-        low,
+        (low, None),
         frame,
         indirect,
         settings,
@@ -128,7 +128,9 @@ pub fn render_split(
 /// in `direct_visibility` (layer k for light k < `directs`, made by the caller with any
 /// technique); the EnvIndirects' is made here with `indirect` over `low` (the receivers of the
 /// G-buffer `passes.gbuffer` renders from [`indirect_camera`]; `receivers` themselves at scale
-/// 1), skipping lights no receiver faces and those Weber's law finds negligible there.
+/// 1), skipping lights no receiver faces and those Weber's law finds negligible there: the
+/// flags given with `low` (per light of the frame, e.g. a [`crate::ReceiverStats`]'s), else
+/// [`weber_negligible`] over its points.
 ///
 /// # Errors
 /// [`GpuError::Failed`] for a scale that does not divide the G-buffer's size, low receivers of
@@ -140,7 +142,7 @@ pub fn record_split(
     passes: &SplitPasses,
     geometry: &SceneGeometry,
     (receivers, direct_visibility): (&Receivers, &Visibility),
-    low: &Receivers,
+    (low, low_negligible): (&Receivers, Option<&[bool]>),
     frame: &SplitFrame,
     indirect: &dyn ShadowTechnique,
     settings: &SplitSettings,
@@ -182,7 +184,11 @@ pub fn record_split(
     let visibility = Visibility::allocate(gpu, lw, lh, indirects.len() as u32)?;
     visibility.record_clear(encoder);
     // the directs count towards what a receiver already gets
-    let negligible = weber_negligible(low, frame.lights, frame.ambient, WEBER_FRACTION).split_off(frame.directs);
+    let mut negligible = match low_negligible {
+        Some(n) => n.to_vec(),
+        None => weber_negligible(low, frame.lights, frame.ambient, WEBER_FRACTION),
+    };
+    let negligible = if negligible.len() >= frame.directs { negligible.split_off(frame.directs) } else { Vec::new() };
     let indirect_reports = record_visibility(gpu, encoder, indirect, low, indirect_shapes, &negligible, &visibility)?;
     let shaded = passes.shading.record_texture(
         gpu,

@@ -95,6 +95,9 @@ pub struct Receivers<'a> {
     /// Where most of what the camera sees is: the mean visible point and the 95th percentile of
     /// distances to it (a shadow map spends its texels there; the far rest stays unshadowed).
     pub focus: Option<(Vec3, f32)>,
+    /// Lights known to be faced (or not) by a visible receiver without the points (from a
+    /// [`crate::ReceiverStats`]); [`Receivers::any_faces`] answers from here first.
+    pub facing: Vec<(LightShape, bool)>,
 }
 
 impl<'a> Receivers<'a> {
@@ -106,13 +109,36 @@ impl<'a> Receivers<'a> {
             lo = lo.min(*p);
             hi = hi.max(*p);
         }
-        Self { gbuffer, points, bounds: lo.is_finite().then_some((lo, hi)), focus: view_focus(points) }
+        Self {
+            gbuffer,
+            points,
+            bounds: lo.is_finite().then_some((lo, hi)),
+            focus: view_focus(points),
+            facing: Vec::new(),
+        }
+    }
+
+    /// The receivers of `gbuffer` as the GPU reduced them ([`crate::ReceiverReduction`], for
+    /// `lights`), without its points: bounds, focus (the GPU's mean, in a fixed summation
+    /// order, and its exact 95th percentile) and which of `lights` a receiver faces.
+    #[must_use]
+    pub fn from_stats(gbuffer: &'a GBuffer, stats: &crate::ReceiverStats, lights: &[LightShape]) -> Self {
+        Self {
+            gbuffer,
+            points: &[],
+            bounds: stats.bounds,
+            focus: stats.mean.zip(stats.radius),
+            facing: lights.iter().copied().zip(stats.faces.iter().copied()).collect(),
+        }
     }
 
     /// Whether any visible receiver has part of `light` above its surface: a light no receiver
     /// faces lights nothing, so it needs no shadow pass.
     #[must_use]
     pub fn any_faces(&self, light: &LightShape) -> bool {
+        if let Some((_, faces)) = self.facing.iter().find(|(l, _)| l == light) {
+            return *faces;
+        }
         self.points.iter().any(|(p, n)| p.is_finite() && light.reaches(*p, *n))
     }
 }
