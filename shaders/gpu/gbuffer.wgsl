@@ -40,21 +40,64 @@ struct GBufferOut {
     @location(2) geometric_normal: vec4<f32>,
 }
 
-@fragment
-fn fs(in: VsOut) -> GBufferOut {
-    var ng = in.geometric_normal;
-    if dot(ng, camera.eye.xyz - in.world) < 0.0 {
+fn surface(world: vec3<f32>, normal: vec3<f32>, geometric_normal: vec3<f32>, object: u32) -> GBufferOut {
+    var ng = geometric_normal;
+    if dot(ng, camera.eye.xyz - world) < 0.0 {
         ng = -ng;
     }
-    var ns = in.normal;
+    var ns = normal;
     let len = length(ns);
     ns = select(ng, ns / len, len > 0.0);
     if dot(ns, ng) < 0.0 {
         ns = -ns;
     }
     var out: GBufferOut;
-    out.position = vec4<f32>(in.world, f32(in.object));
+    out.position = vec4<f32>(world, f32(object));
     out.normal = vec4<f32>(ns, 0.0);
     out.geometric_normal = vec4<f32>(ng, 0.0);
     return out;
+}
+
+@fragment
+fn fs(in: VsOut) -> GBufferOut {
+    return surface(in.world, in.normal, in.geometric_normal, in.object);
+}
+
+// Within WebGPU's default limits (32 colour bytes a sample) the G-buffer takes two passes over
+// the same geometry: position and shading normal, then the geometric normal where the depth is
+// equal. The clip position is invariant, so both passes rasterize the same fragments.
+
+struct VsOutInvariant {
+    @builtin(position) @invariant clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) @interpolate(flat) geometric_normal: vec3<f32>,
+    @location(3) @interpolate(flat) object: u32,
+}
+
+@vertex
+fn vs_invariant(v: VsIn) -> VsOutInvariant {
+    var out: VsOutInvariant;
+    out.clip = camera.view_proj * vec4<f32>(v.position, 1.0);
+    out.world = v.position;
+    out.normal = v.normal;
+    out.geometric_normal = v.geometric_normal;
+    out.object = v.object;
+    return out;
+}
+
+struct SurfaceOut {
+    @location(0) position: vec4<f32>,
+    @location(1) normal: vec4<f32>,
+}
+
+@fragment
+fn fs_surface(in: VsOutInvariant) -> SurfaceOut {
+    let g = surface(in.world, in.normal, in.geometric_normal, in.object);
+    return SurfaceOut(g.position, g.normal);
+}
+
+@fragment
+fn fs_geometric(in: VsOutInvariant) -> @location(0) vec4<f32> {
+    return surface(in.world, in.normal, in.geometric_normal, in.object).geometric_normal;
 }

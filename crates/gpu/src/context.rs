@@ -239,9 +239,8 @@ impl Gpu {
     /// Wraps a device and queue the caller already has (a winit surface's, Bevy's
     /// `RenderDevice`), with its adapter's `info`. The toolkit uses the features and limits the
     /// device was created with: `CLIP_DISTANCES`, `FLOAT32_BLENDABLE` and timestamp queries are
-    /// used when enabled and done without otherwise. Not yet within `wgpu::Limits::default()`:
-    /// the G-buffer's three `Rgba32Float` targets need 48 colour bytes a sample (the default
-    /// allows 32), so give the device the adapter's limits.
+    /// used when enabled and done without otherwise. Every technique runs within
+    /// `wgpu::Limits::default()` (WebGPU's): there the G-buffer takes two passes.
     #[must_use]
     pub fn from_device(device: wgpu::Device, queue: wgpu::Queue, info: wgpu::AdapterInfo) -> Self {
         let features = device.features();

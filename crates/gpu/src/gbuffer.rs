@@ -63,47 +63,89 @@ struct CameraUniform {
     eye: [f32; 4],
 }
 
-/// The G-buffer pass: its pipeline, built once, rendering a [`GBuffer`] per view.
+/// The G-buffer pass: its pipelines, built once, rendering a [`GBuffer`] per view.
 pub struct GBufferPass {
-    pipeline: wgpu::RenderPipeline,
+    // one pass writing all three targets, or (within 32 colour bytes a sample) position and
+    // normal first, then the geometric normal where the depth is equal
+    passes: Passes,
 }
 
+enum Passes {
+    One(wgpu::RenderPipeline),
+    Two(wgpu::RenderPipeline, wgpu::RenderPipeline),
+}
+
+/// Colour bytes a sample the one-pass G-buffer writes (three `Rgba32Float` targets).
+const ONE_PASS_BYTES: u32 = 48;
+
 impl GBufferPass {
-    /// Builds the pipeline.
+    /// Builds the pipelines: one pass where the device allows 48 colour bytes a sample, else
+    /// two (WebGPU's default limits allow 32).
     #[must_use]
     pub fn new(gpu: &Gpu) -> Self {
-        let module =
-            crate::shader::module(&gpu.device, "gbuffer", include_str!("../../../shaders/gpu/gbuffer.wgsl"), &[]);
-        let targets: [Option<wgpu::ColorTargetState>; 3] = std::array::from_fn(|_| Some(GBUFFER_FORMAT.into()));
-        let pipeline = gpu.render_pipeline(&wgpu::RenderPipelineDescriptor {
+        if gpu.limits.max_color_attachment_bytes_per_sample >= ONE_PASS_BYTES {
+            Self::one_pass(gpu)
+        } else {
+            Self::two_passes(gpu)
+        }
+    }
+
+    /// The G-buffer in two passes whatever the device allows (what `new` builds within
+    /// WebGPU's default limits); the same G-buffer as one pass.
+    #[must_use]
+    pub fn two_passes(gpu: &Gpu) -> Self {
+        let module = Self::module(gpu);
+        let surface = Self::pipeline(gpu, &module, ("vs_invariant", "fs_surface"), 2, true);
+        let geometric = Self::pipeline(gpu, &module, ("vs_invariant", "fs_geometric"), 1, false);
+        Self { passes: Passes::Two(surface, geometric) }
+    }
+
+    fn one_pass(gpu: &Gpu) -> Self {
+        let module = Self::module(gpu);
+        Self { passes: Passes::One(Self::pipeline(gpu, &module, ("vs", "fs"), 3, true)) }
+    }
+
+    fn module(gpu: &Gpu) -> wgpu::ShaderModule {
+        crate::shader::module(&gpu.device, "gbuffer", include_str!("../../../shaders/gpu/gbuffer.wgsl"), &[])
+    }
+
+    /// A pipeline writing `targets` G-buffer targets; the first pass writes depth (reversed Z,
+    /// see `view_projection_reverse`), a second one draws where it is equal.
+    fn pipeline(
+        gpu: &Gpu,
+        module: &wgpu::ShaderModule,
+        (vs, fs): (&str, &str),
+        targets: usize,
+        first: bool,
+    ) -> wgpu::RenderPipeline {
+        let targets: Vec<Option<wgpu::ColorTargetState>> = (0..targets).map(|_| Some(GBUFFER_FORMAT.into())).collect();
+        gpu.render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("gbuffer"),
             layout: None,
             vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs"),
+                module,
+                entry_point: Some(vs),
                 compilation_options: Default::default(),
                 buffers: &[Some(SceneGeometry::LAYOUT)],
             },
             primitive: wgpu::PrimitiveState::default(),
             depth_stencil: Some(wgpu::DepthStencilState {
                 format: wgpu::TextureFormat::Depth32Float,
-                depth_write_enabled: Some(true),
-                // reversed Z (see `view_projection_reverse`)
-                depth_compare: Some(wgpu::CompareFunction::Greater),
+                depth_write_enabled: Some(first),
+                depth_compare: Some(if first { wgpu::CompareFunction::Greater } else { wgpu::CompareFunction::Equal }),
                 stencil: Default::default(),
                 bias: Default::default(),
             }),
             multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs"),
+                module,
+                entry_point: Some(fs),
                 compilation_options: Default::default(),
                 targets: &targets,
             }),
             multiview_mask: None,
             cache: None,
-        });
-        Self { pipeline }
+        })
     }
 
     /// Renders the G-buffer of `geometry` seen by `camera` and waits for it.
@@ -152,44 +194,52 @@ impl GBufferPass {
             contents: bytemuck::bytes_of(&uniform),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("gbuffer"),
-            layout: &self.pipeline.get_bind_group_layout(0),
-            entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }],
-        });
         let views = [&gb.position, &gb.normal, &gb.geometric_normal].map(|t| t.create_view(&Default::default()));
         let clear =
             [wgpu::Color { r: 0.0, g: 0.0, b: 0.0, a: -1.0 }, wgpu::Color::TRANSPARENT, wgpu::Color::TRANSPARENT];
-        let attachments: Vec<_> = views
-            .iter()
-            .zip(clear)
-            .map(|(view, c)| {
-                Some(wgpu::RenderPassColorAttachment {
-                    view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations { load: wgpu::LoadOp::Clear(c), store: wgpu::StoreOp::Store },
-                })
+        let attachment = |k: usize| {
+            Some(wgpu::RenderPassColorAttachment {
+                view: &views[k],
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(clear[k]), store: wgpu::StoreOp::Store },
             })
-            .collect();
+        };
         let depth_view = gb.depth.create_view(&Default::default());
-        {
+        let (first, second) = match &self.passes {
+            Passes::One(p) => (p, None),
+            Passes::Two(a, b) => (a, Some(b)),
+        };
+        let mut draw = |pipeline: &wgpu::RenderPipeline, targets: &[usize], depth_load: wgpu::LoadOp<f32>| {
+            let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("gbuffer"),
+                layout: &pipeline.get_bind_group_layout(0),
+                entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }],
+            });
+            let attachments: Vec<_> = targets.iter().map(|&k| attachment(k)).collect();
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("gbuffer"),
                 color_attachments: &attachments,
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                     view: &depth_view,
-                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Store }),
+                    depth_ops: Some(wgpu::Operations { load: depth_load, store: wgpu::StoreOp::Store }),
                     stencil_ops: None,
                 }),
                 timestamp_writes: None,
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(&self.pipeline);
+            pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &bind, &[]);
             pass.set_vertex_buffer(0, geometry.vertices.slice(..));
             pass.draw(0..geometry.vertex_count, 0..1);
+        };
+        match second {
+            None => draw(first, &[0, 1, 2], wgpu::LoadOp::Clear(0.0)),
+            Some(second) => {
+                draw(first, &[0, 1], wgpu::LoadOp::Clear(0.0));
+                draw(second, &[2], wgpu::LoadOp::Load);
+            }
         }
         Ok(gb)
     }

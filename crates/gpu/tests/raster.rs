@@ -443,8 +443,7 @@ fn a_callers_device_renders_the_same_and_is_counted() {
     let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
     let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::PRIMARY));
     let adapter = adapters.into_iter().find(|a| a.get_info() == ours.info).expect("the same adapter");
-    // the adapter's limits: the G-buffer's three Rgba32Float targets (48 bytes a sample) exceed
-    // WebGPU's default 32 (issue 33 owes a G-buffer within the defaults)
+    // the adapter's limits (WebGPU's defaults: benches/tests/default_limits.rs)
     let descriptor = wgpu::DeviceDescriptor { required_limits: adapter.limits(), ..Default::default() };
     let (device, queue) = pollster::block_on(adapter.request_device(&descriptor)).expect("a device");
     let theirs = Gpu::from_device(device, queue, adapter.get_info());

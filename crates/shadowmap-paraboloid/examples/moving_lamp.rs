@@ -145,8 +145,8 @@ fn objects() -> Vec<scene::Mesh> {
 /// # Errors
 /// No adapter or device; a map that cannot be read; GPU failures.
 pub fn run(map: Option<&Path>, out: &Path, frames: usize, (w, h): (u32, u32)) -> Result<Vec<PathBuf>, Box<dyn Error>> {
-    // 1. The renderer's own device (here with the adapter's limits: the toolkit's G-buffer
-    //    formats need 48 colour bytes a sample).
+    // 1. The renderer's own device (with the adapter's limits: this renderer's G-buffer writes
+    //    three Rgba32Float targets, 48 colour bytes a sample; WebGPU's defaults allow 32).
     let instance = wgpu::Instance::default();
     let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions::default()))?;
     let wanted = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::FLOAT32_BLENDABLE | wgpu::Features::CLIP_DISTANCES;
