@@ -16,7 +16,8 @@ struct VsIn {
 }
 
 struct VsOut {
-    @builtin(position) clip: vec4<f32>,
+    // invariant: the two-pass G-buffer's passes rasterize the same fragments
+    @builtin(position) @invariant clip: vec4<f32>,
     @location(0) world: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) @interpolate(flat) geometric_normal: vec3<f32>,
@@ -65,26 +66,7 @@ fn fs(in: VsOut) -> GBufferOut {
 
 // Within WebGPU's default limits (32 colour bytes a sample) the G-buffer takes two passes over
 // the same geometry: position and shading normal, then the geometric normal where the depth is
-// equal. The clip position is invariant, so both passes rasterize the same fragments.
-
-struct VsOutInvariant {
-    @builtin(position) @invariant clip: vec4<f32>,
-    @location(0) world: vec3<f32>,
-    @location(1) normal: vec3<f32>,
-    @location(2) @interpolate(flat) geometric_normal: vec3<f32>,
-    @location(3) @interpolate(flat) object: u32,
-}
-
-@vertex
-fn vs_invariant(v: VsIn) -> VsOutInvariant {
-    var out: VsOutInvariant;
-    out.clip = camera.view_proj * vec4<f32>(v.position, 1.0);
-    out.world = v.position;
-    out.normal = v.normal;
-    out.geometric_normal = v.geometric_normal;
-    out.object = v.object;
-    return out;
-}
+// equal.
 
 struct SurfaceOut {
     @location(0) position: vec4<f32>,
@@ -92,12 +74,12 @@ struct SurfaceOut {
 }
 
 @fragment
-fn fs_surface(in: VsOutInvariant) -> SurfaceOut {
+fn fs_surface(in: VsOut) -> SurfaceOut {
     let g = surface(in.world, in.normal, in.geometric_normal, in.object);
     return SurfaceOut(g.position, g.normal);
 }
 
 @fragment
-fn fs_geometric(in: VsOutInvariant) -> @location(0) vec4<f32> {
+fn fs_geometric(in: VsOut) -> @location(0) vec4<f32> {
     return surface(in.world, in.normal, in.geometric_normal, in.object).geometric_normal;
 }

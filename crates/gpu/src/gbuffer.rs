@@ -95,8 +95,8 @@ impl GBufferPass {
     #[must_use]
     pub fn two_passes(gpu: &Gpu) -> Self {
         let module = Self::module(gpu);
-        let surface = Self::pipeline(gpu, &module, ("vs_invariant", "fs_surface"), 2, true);
-        let geometric = Self::pipeline(gpu, &module, ("vs_invariant", "fs_geometric"), 1, false);
+        let surface = Self::pipeline(gpu, &module, ("vs", "fs_surface"), 2, true);
+        let geometric = Self::pipeline(gpu, &module, ("vs", "fs_geometric"), 1, false);
         Self { passes: Passes::Two(surface, geometric) }
     }
 
