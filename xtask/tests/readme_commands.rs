@@ -158,6 +158,12 @@ fn bench_problem(args: &[&str], benches: &[(String, Vec<String>)], defaults: &[S
     }
 }
 
+/// `cargo run --release -p KRATE --example NAME`: the example's file must exist.
+fn example_problem(krate: &str, name: &str) -> Option<String> {
+    let file = root().join("crates").join(krate).join("examples").join(format!("{name}.rs"));
+    (!file.exists()).then(|| format!("no example {}", file.display()))
+}
+
 #[test]
 fn every_command_in_the_readme_and_docs_runs_as_written() {
     let (benches, defaults) = workspace();
@@ -173,6 +179,8 @@ fn every_command_in_the_readme_and_docs_runs_as_written() {
             ["cargo", "xtask"] => None,
             ["cargo", "xtask", args @ ..] => xtask_problem(args),
             ["cargo", "bench", args @ ..] => bench_problem(args, &benches, &defaults),
+            // an example: its crate's file
+            ["cargo", "run", "--release", "-p", krate, "--example", name, ..] => example_problem(krate, name),
             ["cargo", ..] => (!ci.lines().any(|l| l.trim() == cmd)).then(|| "not a line of .ci/run".to_string()),
             [script, args @ ..] => {
                 let path = root().join(script);
@@ -206,4 +214,6 @@ fn the_checks_find_what_would_fail() {
     let (benches, defaults) = workspace();
     assert!(bench_problem(&["--bench", "no_such_bench"], &benches, &defaults).is_some());
     assert!(bench_problem(&["-p", "envshadow-benches", "--bench", "shafts"], &benches, &defaults).is_none());
+    assert!(example_problem("penumbra-wedge", "no_such_example").is_some());
+    assert!(example_problem("penumbra-wedge", "moving_box").is_none());
 }
