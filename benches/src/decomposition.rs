@@ -186,6 +186,55 @@ impl Frame {
         Ok(split.texture)
     }
 
+    /// The same frame with its receivers made on the CPU from the G-buffers' points mapped back
+    /// (32 bytes a pixel; `Receivers::new`, `weber_negligible`), waited for: the reference the
+    /// GPU reduction of [`Frame::render`] is tested against, not a real-time path.
+    ///
+    /// # Errors
+    /// As [`Frame::render`].
+    pub fn render_from_cpu_receivers(&self, gpu: &Gpu, scale: u32) -> Result<wgpu::Texture, GpuError> {
+        let d = &self.decomposition;
+        let lights: Vec<ShadeLight> = d.lights.iter().map(|l| ShadeLight::from(&l.light)).collect();
+        let shapes: Vec<LightShape> = d.lights.iter().map(|l| LightShape::from(&l.light)).collect();
+        let directs = d.directs();
+        let settings = SplitSettings { indirect_scale: scale, upsample: JointBilateral::PAPER };
+        let low_camera = indirect_camera(&self.scene.camera, &settings)?;
+        let gb = self.gbuffer.render(gpu, &self.geometry, &self.scene.camera)?;
+        let low_gb = (scale != 1).then(|| self.gbuffer.render(gpu, &self.geometry, &low_camera)).transpose()?;
+        let points = gb.read_points(gpu)?;
+        let low_points = low_gb.as_ref().map(|l| l.read_points(gpu)).transpose()?;
+        let receivers = Receivers::new(&gb, &points);
+        let low_receivers = low_gb.as_ref().zip(low_points.as_deref()).map(|(l, p)| Receivers::new(l, p));
+        let low = low_receivers.as_ref().unwrap_or(&receivers);
+        let negligible = gpu::weber_negligible(&receivers, &lights, Some(&d.ambient_sh), WEBER_FRACTION);
+        let mut encoder = gpu.encoder("frame");
+        let (w, h) = gb.size();
+        let vis = Visibility::allocate(gpu, w, h, directs as u32)?;
+        vis.record_clear(&mut encoder);
+        let wedges: &dyn ShadowTechnique = &self.wedges;
+        record_visibility(gpu, &mut encoder, wedges, &receivers, &shapes[..directs], &negligible[..directs], &vis)?;
+        let split = record_split(
+            gpu,
+            &mut encoder,
+            &SplitPasses { gbuffer: &self.gbuffer, shading: &self.shading, upsample: &self.upsample },
+            &self.geometry,
+            (&receivers, &vis),
+            (low, None),
+            &SplitFrame {
+                lights: &lights,
+                shapes: &shapes,
+                directs,
+                ambient: Some(&d.ambient_sh),
+                specular_ambient: Some(&self.specular),
+                background: Some(&self.background),
+            },
+            &self.maps,
+            &settings,
+        )?;
+        gpu.submit_and_wait(encoder)?;
+        Ok(split.texture)
+    }
+
     /// [`Frame::render`] waited for: the wall time of the whole frame (CPU work included) and
     /// the image.
     ///

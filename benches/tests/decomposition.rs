@@ -91,3 +91,20 @@ fn a_moving_object_frame_equals_a_frame_built_for_its_pose() {
         );
     }
 }
+
+#[test]
+fn the_gpu_reduced_receivers_frame_matches_the_cpu_receivers_frame() {
+    // the GPU sums the focus's mean in another order: the maps' texels sit a rounding apart
+    let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
+    let map = envmap_sphere::default_map();
+    let frame = Frame::new(&gpu, "spheres_box", (160, 120), &map, 32).unwrap_or_else(|e| panic!("{e}"));
+    for scale in [1, 2] {
+        let gpu_image = gpu::read_hdr(&gpu, &frame.render_timed(&gpu, scale).unwrap().1).unwrap();
+        let cpu_image = gpu::read_hdr(&gpu, &frame.render_from_cpu_receivers(&gpu, scale).unwrap()).unwrap();
+        let tm = ref_tracer::metrics::FlipTonemap::for_reference(&cpu_image);
+        let flip = ref_tracer::metrics::flip(&cpu_image, &gpu_image, 160, 120, &tm);
+        let rmse = ref_tracer::metrics::rmse(&cpu_image, &gpu_image);
+        let differ = cpu_image.iter().zip(&gpu_image).filter(|(a, b)| a != b).count();
+        assert!(flip <= 1e-3 && rmse <= 1e-3, "scale {scale}: FLIP {flip}, RMSE {rmse}, {differ} pixels differ");
+    }
+}
