@@ -48,6 +48,14 @@ pub fn animation_offset(scene: &scene::Scene, object: usize, k: usize) -> glam::
     glam::Vec3::new(r * (a.cos() - 1.0), 0.0, r * a.sin())
 }
 
+/// A frame's image (submitted, not waited for) and what its shadow passes did.
+pub struct RenderedFrame {
+    /// The HDR image.
+    pub texture: wgpu::Texture,
+    /// Per light, EnvDirects first: its shadow pass, or why it had none.
+    pub reports: Vec<gpu::ShadowPassReport>,
+}
+
 /// Everything a frame needs that does not change between frames.
 pub struct Frame {
     /// The scene, its camera at the frame's size (objects at their current poses).
@@ -134,7 +142,7 @@ impl Frame {
     ///
     /// # Errors
     /// GPU failures; a scale that does not divide the size.
-    pub fn render(&self, gpu: &Gpu, scale: u32) -> Result<wgpu::Texture, GpuError> {
+    pub fn render(&self, gpu: &Gpu, scale: u32) -> Result<RenderedFrame, GpuError> {
         let d = &self.decomposition;
         let lights: Vec<ShadeLight> = d.lights.iter().map(|l| ShadeLight::from(&l.light)).collect();
         let shapes: Vec<LightShape> = d.lights.iter().map(|l| LightShape::from(&l.light)).collect();
@@ -163,7 +171,8 @@ impl Frame {
         let vis = Visibility::allocate(gpu, w, h, directs as u32)?;
         vis.record_clear(&mut encoder);
         let wedges: &dyn ShadowTechnique = &self.wedges;
-        record_visibility(gpu, &mut encoder, wedges, &receivers, &shapes[..directs], &negligible[..directs], &vis)?;
+        let mut reports =
+            record_visibility(gpu, &mut encoder, wedges, &receivers, &shapes[..directs], &negligible[..directs], &vis)?;
         let split = record_split(
             gpu,
             &mut encoder,
@@ -183,7 +192,8 @@ impl Frame {
             &settings,
         )?;
         gpu.submit(encoder);
-        Ok(split.texture)
+        reports.extend(split.indirect_reports);
+        Ok(RenderedFrame { texture: split.texture, reports })
     }
 
     /// The same frame with its receivers made on the CPU from the G-buffers' points mapped back
@@ -242,7 +252,7 @@ impl Frame {
     /// As [`Frame::render`].
     pub fn render_timed(&self, gpu: &Gpu, scale: u32) -> Result<(Duration, wgpu::Texture), GpuError> {
         let start = Instant::now();
-        let texture = self.render(gpu, scale)?;
+        let texture = self.render(gpu, scale)?.texture;
         gpu.wait(None)?;
         Ok((start.elapsed(), texture))
     }

@@ -78,10 +78,11 @@ fn a_moving_object_frame_equals_a_frame_built_for_its_pose() {
     frame.move_object(&gpu, object, animation_offset(frame.rest(), object, 5)).unwrap();
     // a frame after the first costs two submissions, one wait and no pipeline
     let before = gpu.counters();
-    let texture = frame.render(&gpu, 2).unwrap();
+    let rendered = frame.render(&gpu, 2).unwrap();
     let d = gpu.counters() - before;
     assert_eq!((d.submits, d.waits, d.pipelines), (2, 1, 0), "{d:?}");
-    let moved = gpu::read_hdr(&gpu, &texture).unwrap();
+    assert_eq!(rendered.reports.len(), frame.decomposition.lights.len());
+    let moved = gpu::read_hdr(&gpu, &rendered.texture).unwrap();
     assert!(moved != at_rest, "the object did not move");
     let fresh = Frame::with_scene(&gpu, frame.scene.clone(), &map, 8).unwrap_or_else(|e| panic!("{e}"));
     for scale in [1, 2] {

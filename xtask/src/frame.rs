@@ -60,17 +60,27 @@ pub fn run(args: &FrameArgs) -> Result<(), String> {
     let scales: &[(&str, u32)] =
         if args.json { &[("", args.scale)] } else { &[("full", 1), ("half", 2), ("quarter", 4)] };
     for &(name, scale) in scales {
+        let mut reports = Vec::new();
         let stats = measure_frames(&gpu, args.repeats, |k| -> Result<(), gpu::GpuError> {
             if let Some(object) = moving {
                 let offset = animation_offset(frame.rest(), object, k);
                 frame.move_object(&gpu, object, offset)?;
             }
-            frame.render(&gpu, scale).map(|_| ())
+            reports = frame.render(&gpu, scale)?.reports;
+            Ok(())
         })
         .map_err(|e| e.to_string())?;
+        // what the last frame skipped and why
+        let skipped = gpu::skip_reasons(&reports);
         if args.json {
-            outln!("{}", json(args, &gpu, &stats, moving.map(|k| frame.rest().objects[k].name.as_str()), lights));
+            let mut v = json(args, &gpu, &stats, moving.map(|k| frame.rest().objects[k].name.as_str()), lights);
+            v["lights_shadowed"] = (reports.len() - skipped.iter().map(|(_, n)| n).sum::<usize>()).into();
+            v["lights_skipped"] = skipped.iter().map(|(why, n)| serde_json::json!({"why": why, "lights": n})).collect();
+            outln!("{v}");
         } else {
+            for (why, n) in &skipped {
+                outln!("  EnvIndirects at {name} resolution: {n} lights without a shadow pass: {why}");
+            }
             outln!(
                 "  EnvIndirects at {name} resolution: median {:.2} ms ({:.1} fps) over {} frames; per frame {} submissions, {} waits, {} bytes read back, {:.2} ms CPU outside waits{}; {} pipelines created after the first frame",
                 stats.wall_ms,

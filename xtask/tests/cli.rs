@@ -212,6 +212,10 @@ fn frame_json_counts_what_a_moving_frame_costs() {
     assert!(v["readback_bytes_per_frame"].as_f64().is_some_and(|b| b > 0.0 && b <= 4096.0), "{v}");
     assert!(v["gpu_ms"].is_null() || v["gpu_ms"].as_f64().is_some_and(|g| g >= 0.0), "{v}");
     assert!(v["adapter"].as_str().is_some_and(|a| !a.is_empty()), "{v}");
+    // every light is shadowed or skipped with a reason
+    let skipped: u64 =
+        v["lights_skipped"].as_array().map_or(0, |a| a.iter().filter_map(|s| s["lights"].as_u64()).sum());
+    assert_eq!(v["lights_shadowed"].as_u64().map(|n| n + skipped), v["lights"].as_u64(), "{v}");
     let out = xtask(&["frame", "--json", "--scale", "3", "--size", "64x48"]);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--scale 3"));
