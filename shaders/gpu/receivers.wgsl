@@ -14,9 +14,11 @@ struct Params {
 }
 
 struct Light {
-    // xyz: direction towards a distant light, or a sphere light's centre
+    // xyz: unit direction towards a distant light (as the CPU normalizes it), or a sphere
+    // light's centre
     place: vec4<f32>,
-    // x: 0 distant, 1 sphere; y: half-angle (distant) or radius (sphere)
+    // x: 0 distant, 1 sphere; y: the sphere's radius; z: a distant light's -sin(half-angle), as
+    // the CPU computes it
     shape: vec4<f32>,
 }
 
@@ -48,7 +50,6 @@ struct Stats {
 @group(0) @binding(5) var<storage, read_write> partials: array<vec4<f32>>;
 @group(0) @binding(6) var<storage, read_write> histogram: array<atomic<u32>, 256>;
 
-const MAX_HALF_ANGLE: f32 = 1.5;
 const HALF_PI: f32 = 1.5707963267948966;
 
 fn key(x: f32) -> u32 {
@@ -62,21 +63,21 @@ fn unit_or_y(v: vec3<f32>) -> vec3<f32> {
 }
 
 fn reaches(l: Light, p: vec3<f32>, n: vec3<f32>) -> bool {
-    var d: vec3<f32>;
-    var half: f32;
     if l.shape.x == 0.0 {
-        d = unit_or_y(l.place.xyz);
-        half = clamp(l.shape.y, 0.0, MAX_HALF_ANGLE);
-    } else {
-        let to = l.place.xyz - p;
-        d = unit_or_y(to);
-        let dist = length(to);
-        half = select(asin(l.shape.y / dist), HALF_PI, dist <= l.shape.y);
+        return dot(n, l.place.xyz) > l.shape.z;
     }
-    return dot(n, d) > -sin(half);
+    let to = l.place.xyz - p;
+    let dist = length(to);
+    let half = select(asin(l.shape.y / dist), HALF_PI, dist <= l.shape.y);
+    return dot(n, unit_or_y(to)) > -sin(half);
 }
 
 var<workgroup> tree: array<vec4<f32>, 256>;
+// per workgroup first (no contended global atomics per pixel), then one global atomic each
+var<workgroup> tree_lo: array<vec3<u32>, 256>;
+var<workgroup> tree_hi: array<vec3<u32>, 256>;
+var<workgroup> group_faces: array<atomic<u32>, 32>;
+var<workgroup> group_histogram: array<atomic<u32>, 256>;
 
 // The workgroup's sum of `mine` into tree[0], pairwise in a fixed order.
 fn tree_sum(local: u32, mine: vec4<f32>) {
@@ -96,30 +97,59 @@ fn reduce(
     @builtin(local_invocation_index) local: u32,
     @builtin(workgroup_id) group: vec3<u32>,
 ) {
+    if local < 32u {
+        atomicStore(&group_faces[local], 0u);
+    }
+    workgroupBarrier();
     var mine = vec4<f32>(0.0);
+    // keys of 0 are below every point's: the neutral element of the maxima
+    var lo = vec3<u32>(0u);
+    var hi = vec3<u32>(0u);
     if id.x < params.size.x && id.y < params.size.y {
         let g = textureLoad(g_position, vec2<i32>(id.xy), 0);
         if g.w >= 0.0 {
             let p = g.xyz;
             let n = textureLoad(g_geometric_normal, vec2<i32>(id.xy), 0).xyz;
-            for (var a = 0u; a < 3u; a++) {
-                atomicMax(&stats.lo[a], ~key(p[a]));
-                atomicMax(&stats.hi[a], key(p[a]));
-            }
-            atomicAdd(&stats.count, 1u);
+            lo = vec3<u32>(~key(p.x), ~key(p.y), ~key(p.z));
+            hi = vec3<u32>(key(p.x), key(p.y), key(p.z));
             mine = vec4<f32>(p, 1.0);
             for (var k = 0u; k < params.size.z; k++) {
                 let bit = 1u << (k % 32u);
                 // once set by anyone, no need to test again
-                if (atomicLoad(&stats.faces[k / 32u]) & bit) == 0u && reaches(lights[k], p, n) {
-                    atomicOr(&stats.faces[k / 32u], bit);
+                if (atomicLoad(&group_faces[k / 32u]) & bit) == 0u && reaches(lights[k], p, n) {
+                    atomicOr(&group_faces[k / 32u], bit);
                 }
             }
         }
     }
-    tree_sum(local, mine);
+    // one tree for the sums and the maxima: the same barriers
+    tree[local] = mine;
+    tree_lo[local] = lo;
+    tree_hi[local] = hi;
+    workgroupBarrier();
+    for (var s = 128u; s > 0u; s >>= 1u) {
+        if local < s {
+            tree[local] += tree[local + s];
+            tree_lo[local] = max(tree_lo[local], tree_lo[local + s]);
+            tree_hi[local] = max(tree_hi[local], tree_hi[local + s]);
+        }
+        workgroupBarrier();
+    }
+    if local < 32u {
+        let f = atomicLoad(&group_faces[local]);
+        if f != 0u {
+            atomicOr(&stats.faces[local], f);
+        }
+    }
     if local == 0u {
         partials[group.y * params.size.w + group.x] = tree[0];
+        if tree[0].w > 0.0 {
+            for (var a = 0u; a < 3u; a++) {
+                atomicMax(&stats.lo[a], tree_lo[0][a]);
+                atomicMax(&stats.hi[a], tree_hi[0][a]);
+            }
+            atomicAdd(&stats.count, u32(tree[0].w));
+        }
     }
 }
 
@@ -144,22 +174,28 @@ fn finish(@builtin(local_invocation_index) local: u32) {
     }
 }
 
-// One byte of the distances' bits, for the points whose higher bytes are the prefix's.
+// One byte of the distances' bits, for the points whose higher bytes are the prefix's: a
+// histogram per workgroup, added into the global one.
 @compute @workgroup_size(16, 16)
-fn histogram_pass(@builtin(global_invocation_id) id: vec3<u32>) {
-    if id.x >= params.size.x || id.y >= params.size.y {
-        return;
+fn histogram_pass(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    atomicStore(&group_histogram[local], 0u);
+    workgroupBarrier();
+    if id.x < params.size.x && id.y < params.size.y {
+        let g = textureLoad(g_position, vec2<i32>(id.xy), 0);
+        if g.w >= 0.0 {
+            let bits = bitcast<u32>(length(g.xyz - stats.mean.xyz));
+            let shift = 24u - 8u * stats.digit;
+            // the bytes above this one (none on the first pass: a shift by 32 is not allowed)
+            let high = select(0xffffffffu << (shift + 8u), 0u, stats.digit == 0u);
+            if (bits & high) == (stats.prefix & high) {
+                atomicAdd(&group_histogram[(bits >> shift) & 255u], 1u);
+            }
+        }
     }
-    let g = textureLoad(g_position, vec2<i32>(id.xy), 0);
-    if g.w < 0.0 {
-        return;
-    }
-    let bits = bitcast<u32>(length(g.xyz - stats.mean.xyz));
-    let shift = 24u - 8u * stats.digit;
-    // the bytes above this one (none on the first pass: a shift by 32 is not allowed)
-    let high = select(0xffffffffu << (shift + 8u), 0u, stats.digit == 0u);
-    if (bits & high) == (stats.prefix & high) {
-        atomicAdd(&histogram[(bits >> shift) & 255u], 1u);
+    workgroupBarrier();
+    let c = atomicLoad(&group_histogram[local]);
+    if c != 0u {
+        atomicAdd(&histogram[local], c);
     }
 }
 

@@ -209,8 +209,13 @@ impl ReceiverReduction {
         let mut shapes: Vec<GpuLight> = lights
             .iter()
             .map(|l| match *l {
-                LightShape::Distant { direction, half_angle } => {
-                    GpuLight { place: direction.extend(0.0).to_array(), shape: [0.0, half_angle, 0.0, 0.0] }
+                LightShape::Distant { .. } => {
+                    // the CPU's own direction and threshold (`LightShape::reaches`), bit for bit
+                    let d = l.direction_from(Vec3::ZERO);
+                    GpuLight {
+                        place: d.extend(0.0).to_array(),
+                        shape: [0.0, 0.0, -l.half_angle_at(Vec3::ZERO).sin(), 0.0],
+                    }
                 }
                 LightShape::Sphere { center, radius } => {
                     GpuLight { place: center.extend(1.0).to_array(), shape: [1.0, radius, 0.0, 0.0] }
