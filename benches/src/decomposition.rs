@@ -134,6 +134,15 @@ impl Frame {
         &self.rest
     }
 
+    /// The frame's lights as the shading pass and the techniques see them, EnvDirects first.
+    fn lights(&self) -> (Vec<ShadeLight>, Vec<LightShape>) {
+        let lights = &self.decomposition.lights;
+        (
+            lights.iter().map(|l| ShadeLight::from(&l.light)).collect(),
+            lights.iter().map(|l| LightShape::from(&l.light)).collect(),
+        )
+    }
+
     /// Renders one frame with the EnvIndirects at 1 / `scale` and returns the image, its work
     /// submitted and not waited for. Two submissions: the G-buffers with their receivers
     /// reduced on the GPU (bounds, focus, the lights they face, Weber's test), whose few hundred
@@ -144,9 +153,7 @@ impl Frame {
     /// GPU failures; a scale that does not divide the size.
     pub fn render(&self, gpu: &Gpu, scale: u32) -> Result<RenderedFrame, GpuError> {
         let d = &self.decomposition;
-        let lights: Vec<ShadeLight> = d.lights.iter().map(|l| ShadeLight::from(&l.light)).collect();
-        let shapes: Vec<LightShape> = d.lights.iter().map(|l| LightShape::from(&l.light)).collect();
-        let directs = d.directs();
+        let (lights, shapes) = self.lights();
         let settings = SplitSettings { indirect_scale: scale, upsample: JointBilateral::PAPER };
         let low_camera = indirect_camera(&self.scene.camera, &settings)?;
         let weber = WeberInput { lights: &lights, ambient: Some(&d.ambient_sh), fraction: WEBER_FRACTION };
@@ -163,37 +170,18 @@ impl Frame {
         let receivers = Receivers::from_stats(&gb, &stats[0], &shapes);
         let low_receivers = low_gb.as_ref().map(|l| Receivers::from_stats(l, &stats[1], &shapes));
         let low = low_receivers.as_ref().unwrap_or(&receivers);
-        let low_negligible = &stats[stats.len() - 1].negligible;
-        let negligible = &stats[0].negligible;
-
         let mut encoder = gpu.encoder("frame");
-        let (w, h) = gb.size();
-        let vis = Visibility::allocate(gpu, w, h, directs as u32)?;
-        vis.record_clear(&mut encoder);
-        let wedges: &dyn ShadowTechnique = &self.wedges;
-        let mut reports =
-            record_visibility(gpu, &mut encoder, wedges, &receivers, &shapes[..directs], &negligible[..directs], &vis)?;
-        let split = record_split(
+        let (negligible, low_negligible) = (&stats[0].negligible, &stats[stats.len() - 1].negligible);
+        let frame = self.record_lit(
             gpu,
             &mut encoder,
-            &SplitPasses { gbuffer: &self.gbuffer, shading: &self.shading, upsample: &self.upsample },
-            &self.geometry,
-            (&receivers, &vis),
+            (&lights, &shapes),
+            (&receivers, negligible),
             (low, Some(low_negligible)),
-            &SplitFrame {
-                lights: &lights,
-                shapes: &shapes,
-                directs,
-                ambient: Some(&d.ambient_sh),
-                specular_ambient: Some(&self.specular),
-                background: Some(&self.background),
-            },
-            &self.maps,
             &settings,
         )?;
         gpu.submit(encoder);
-        reports.extend(split.indirect_reports);
-        Ok(RenderedFrame { texture: split.texture, reports })
+        Ok(frame)
     }
 
     /// The same frame with its receivers made on the CPU from the G-buffers' points mapped back
@@ -203,10 +191,7 @@ impl Frame {
     /// # Errors
     /// As [`Frame::render`].
     pub fn render_from_cpu_receivers(&self, gpu: &Gpu, scale: u32) -> Result<wgpu::Texture, GpuError> {
-        let d = &self.decomposition;
-        let lights: Vec<ShadeLight> = d.lights.iter().map(|l| ShadeLight::from(&l.light)).collect();
-        let shapes: Vec<LightShape> = d.lights.iter().map(|l| LightShape::from(&l.light)).collect();
-        let directs = d.directs();
+        let (lights, shapes) = self.lights();
         let settings = SplitSettings { indirect_scale: scale, upsample: JointBilateral::PAPER };
         let low_camera = indirect_camera(&self.scene.camera, &settings)?;
         let gb = self.gbuffer.render(gpu, &self.geometry, &self.scene.camera)?;
@@ -216,33 +201,55 @@ impl Frame {
         let receivers = Receivers::new(&gb, &points);
         let low_receivers = low_gb.as_ref().zip(low_points.as_deref()).map(|(l, p)| Receivers::new(l, p));
         let low = low_receivers.as_ref().unwrap_or(&receivers);
-        let negligible = gpu::weber_negligible(&receivers, &lights, Some(&d.ambient_sh), WEBER_FRACTION);
+        let ambient = Some(&self.decomposition.ambient_sh);
+        let negligible = gpu::weber_negligible(&receivers, &lights, ambient, WEBER_FRACTION);
         let mut encoder = gpu.encoder("frame");
-        let (w, h) = gb.size();
+        let frame =
+            self.record_lit(gpu, &mut encoder, (&lights, &shapes), (&receivers, &negligible), (low, None), &settings)?;
+        gpu.submit_and_wait(encoder)?;
+        Ok(frame.texture)
+    }
+
+    /// Records the EnvDirects' wedges over `receivers` and the split frame over them and `low`
+    /// (each with its Weber flags; `None`: from the low receivers' points).
+    fn record_lit(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        (lights, shapes): (&[ShadeLight], &[LightShape]),
+        (receivers, negligible): (&Receivers, &[bool]),
+        low: (&Receivers, Option<&[bool]>),
+        settings: &SplitSettings,
+    ) -> Result<RenderedFrame, GpuError> {
+        let d = &self.decomposition;
+        let directs = d.directs();
+        let (w, h) = receivers.gbuffer.size();
         let vis = Visibility::allocate(gpu, w, h, directs as u32)?;
-        vis.record_clear(&mut encoder);
+        vis.record_clear(encoder);
         let wedges: &dyn ShadowTechnique = &self.wedges;
-        record_visibility(gpu, &mut encoder, wedges, &receivers, &shapes[..directs], &negligible[..directs], &vis)?;
+        let direct_negligible = negligible.get(..directs).unwrap_or(&[]);
+        let mut reports =
+            record_visibility(gpu, encoder, wedges, receivers, &shapes[..directs], direct_negligible, &vis)?;
         let split = record_split(
             gpu,
-            &mut encoder,
+            encoder,
             &SplitPasses { gbuffer: &self.gbuffer, shading: &self.shading, upsample: &self.upsample },
             &self.geometry,
-            (&receivers, &vis),
-            (low, None),
+            (receivers, &vis),
+            low,
             &SplitFrame {
-                lights: &lights,
-                shapes: &shapes,
+                lights,
+                shapes,
                 directs,
                 ambient: Some(&d.ambient_sh),
                 specular_ambient: Some(&self.specular),
                 background: Some(&self.background),
             },
             &self.maps,
-            &settings,
+            settings,
         )?;
-        gpu.submit_and_wait(encoder)?;
-        Ok(split.texture)
+        reports.extend(split.indirect_reports);
+        Ok(RenderedFrame { texture: split.texture, reports })
     }
 
     /// [`Frame::render`] waited for: the wall time of the whole frame (CPU work included) and
