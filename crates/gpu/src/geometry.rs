@@ -225,6 +225,12 @@ impl ShadowGeometry {
         })
     }
 
+    /// Every triangle, in the order of the vertex buffer (world space).
+    #[must_use]
+    pub fn triangle_soup(&self) -> &[[Vec3; 3]] {
+        &self.soup
+    }
+
     /// Replaces triangles `first..first + triangles.len()` (a moved object's) with
     /// `queue.write_buffer` and recomputes the bounds of the chunks they fall in: what
     /// [`ShadowGeometry::upload`] of the changed soup would give, without a new buffer.

@@ -24,10 +24,9 @@ pub struct MapTechnique {
 /// What every setting of a scene's maps shares: pipelines and geometry.
 struct Shared {
     mapper: ShadowMapper,
-    // the scene's triangles and their chunks, updated in place when an object moves
-    triangles: RefCell<Vec<[Vec3; 3]>>,
+    // the scene's triangles in chunks, updated in place when an object moves
     geometry: RefCell<ShadowGeometry>,
-    // per object, its first triangle in `triangles` and its triangle count
+    // per object, its first triangle in the geometry and its triangle count
     objects: Vec<(usize, usize)>,
     resolve: ResolvePass,
 }
@@ -88,7 +87,6 @@ impl MapTechnique {
             .collect();
         let shared = Shared {
             mapper: ShadowMapper::new(gpu),
-            triangles: RefCell::new(triangles),
             geometry: RefCell::new(geometry),
             objects,
             resolve: ResolvePass::new(gpu),
@@ -125,7 +123,6 @@ impl MapTechnique {
             )));
         };
         let moved: Vec<[Vec3; 3]> = (0..count).map(|t| mesh.triangle(t)).collect();
-        self.shared.triangles.borrow_mut()[first..first + count].copy_from_slice(&moved);
         self.shared.geometry.borrow_mut().update(gpu, first, &moved)
     }
 
@@ -197,10 +194,9 @@ impl ShadowTechnique for MapTechnique {
         };
         let shared = &self.shared;
         let subdivided;
-        let triangles = shared.triangles.borrow();
         let geometry = shared.geometry.borrow();
         let geometry = if self.technique == Technique::DualParaboloid && settings.subdivide_angle.is_some() {
-            let t = shadow_triangles(&triangles, &lights[0], self.technique, &settings);
+            let t = shadow_triangles(geometry.triangle_soup(), &lights[0], self.technique, &settings);
             subdivided = ShadowGeometry::upload(gpu, &t, ShadowGeometry::CHUNK_TRIANGLES)?;
             &subdivided
         } else {
