@@ -6,7 +6,7 @@
 
 use envmap_sphere::EnvMap;
 use gpu::{
-    Background, GBufferPass, Gpu, GpuError, JointBilateral, LightShape, PendingStats, PrefilterSettings,
+    Background, GBufferPass, Gpu, GpuError, JointBilateral, LightShape, MappedStats, PendingStats, PrefilterSettings,
     ReceiverReduction, Receivers, SceneGeometry, ShadeLight, ShadingPass, ShadowTechnique, SpecularAmbient, SplitFrame,
     SplitPasses, SplitSettings, UpsamplePass, Visibility, WEBER_FRACTION, WeberInput, indirect_camera, record_split,
     record_visibility,
@@ -52,8 +52,34 @@ pub fn animation_offset(scene: &scene::Scene, object: usize, k: usize) -> glam::
 pub struct RenderedFrame {
     /// The HDR image.
     pub texture: wgpu::Texture,
-    /// Per light, EnvDirects first: its shadow pass, or why it had none.
+    /// Per light, EnvDirects first: its shadow pass as recorded, or why it had none. Where the
+    /// GPU gated the lights, which it skipped is known once the frame has run:
+    /// [`RenderedFrame::finish_reports`].
     pub reports: Vec<gpu::ShadowPassReport>,
+    // the receivers' statistics being mapped (full resolution, then low), and the EnvDirects
+    gated: Option<(Vec<MappedStats>, usize)>,
+}
+
+impl RenderedFrame {
+    /// The reports with the lights the GPU skipped marked (why, and nothing drawn), read once
+    /// the frame has finished (after the caller's own wait, or a later frame's): no wait of
+    /// its own, a few hundred bytes.
+    ///
+    /// # Errors
+    /// The frame has not finished; GPU failures.
+    pub fn finish_reports(self, gpu: &Gpu) -> Result<(wgpu::Texture, Vec<gpu::ShadowPassReport>), GpuError> {
+        let mut reports = self.reports;
+        if let Some((mapped, directs)) = self.gated {
+            let stats = mapped.into_iter().map(|m| m.finish(gpu)).collect::<Result<Vec<_>, _>>()?;
+            for (k, r) in reports.iter_mut().enumerate() {
+                let s = if k < directs { stats.first() } else { stats.last() };
+                if let Some(why) = s.and_then(|s| s.skip_reason(k)) {
+                    *r = gpu::ShadowPassReport { skipped: Some(why), ..gpu::ShadowPassReport::default() };
+                }
+            }
+        }
+        Ok((self.texture, reports))
+    }
 }
 
 /// Everything a frame needs that does not change between frames.
@@ -144,10 +170,14 @@ impl Frame {
     }
 
     /// Renders one frame with the EnvIndirects at 1 / `scale` and returns the image, its work
-    /// submitted and not waited for. Two submissions: the G-buffers with their receivers
-    /// reduced on the GPU (bounds, focus, the lights they face, Weber's test), whose few hundred
-    /// bytes are mapped back (one wait: the wedges' plans and the maps' matrices are still made
-    /// on the CPU), then everything else recorded into one encoder.
+    /// submitted and not waited for: no wait, no readback inside it. Two submissions: the
+    /// G-buffers with their receivers reduced on the GPU (bounds, focus, the lights they face,
+    /// Weber's test), then everything else recorded into one encoder, which the CPU records
+    /// meanwhile. The reduction stays on the GPU: it gates each light's draws (lights no
+    /// receiver faces and those Weber's law finds negligible draw nothing) and fits the
+    /// orthographic maps; the wedges are planned from what the CPU knows, the scene's box
+    /// within the view ([`gpu::conservative_bounds`]). Its few hundred bytes are mapped for
+    /// [`RenderedFrame::finish_reports`].
     ///
     /// # Errors
     /// GPU failures; a scale that does not divide the size.
@@ -156,16 +186,36 @@ impl Frame {
         let (lights, shapes) = self.lights();
         let settings = SplitSettings { indirect_scale: scale, upsample: JointBilateral::PAPER };
         let low_camera = indirect_camera(&self.scene.camera, &settings)?;
-        let weber = WeberInput { lights: &lights, ambient: Some(&d.ambient_sh), fraction: WEBER_FRACTION };
-        let mut encoder = gpu.encoder("frame g-buffers");
-        let gb = self.gbuffer.record(gpu, &mut encoder, &self.geometry, &self.scene.camera)?;
-        let low_gb =
-            (scale != 1).then(|| self.gbuffer.record(gpu, &mut encoder, &self.geometry, &low_camera)).transpose()?;
-        let mut pending = vec![self.reductions[0].record(gpu, &mut encoder, &gb, &shapes, Some(weber))?];
-        if let Some(l) = &low_gb {
-            pending.push(self.reductions[1].record(gpu, &mut encoder, l, &shapes, Some(weber))?);
-        }
+        let (gb, low_gb, pending) = self.submit_reduced(gpu, &lights, &shapes, &low_camera, scale)?;
+        let scene_box = scene_bounds(&self.scene);
+        let directs = d.directs() as u32;
+        let bounds = scene_box.and_then(|b| gpu::conservative_bounds(b, &self.scene.camera));
+        let receivers = Receivers::on_gpu(&gb, bounds, pending[0].on_gpu().clone());
+        let low_gpu = pending[pending.len() - 1].on_gpu().starting_at(directs);
+        let low = match &low_gb {
+            Some(l) => Receivers::on_gpu(l, scene_box.and_then(|b| gpu::conservative_bounds(b, &low_camera)), low_gpu),
+            None => Receivers::on_gpu(&gb, bounds, low_gpu),
+        };
+        let mut encoder = gpu.encoder("frame");
+        let frame =
+            self.record_lit(gpu, &mut encoder, (&lights, &shapes), (&receivers, &[]), (&low, Some(&[])), &settings)?;
         gpu.submit(encoder);
+        let mapped = pending.into_iter().map(|p| p.map(gpu)).collect();
+        Ok(RenderedFrame { gated: Some((mapped, directs as usize)), ..frame })
+    }
+
+    /// The same frame with the CPU waiting for the GPU's reduction (a few hundred bytes) and
+    /// planning every light from it: lights skipped on the CPU, the wedges planned for the
+    /// receivers' exact bounds, the maps fitted on the CPU. What the frame did before its
+    /// lights were gated on the GPU, kept as a second reference for [`Frame::render`].
+    ///
+    /// # Errors
+    /// As [`Frame::render`].
+    pub fn render_from_read_stats(&self, gpu: &Gpu, scale: u32) -> Result<RenderedFrame, GpuError> {
+        let (lights, shapes) = self.lights();
+        let settings = SplitSettings { indirect_scale: scale, upsample: JointBilateral::PAPER };
+        let low_camera = indirect_camera(&self.scene.camera, &settings)?;
+        let (gb, low_gb, pending) = self.submit_reduced(gpu, &lights, &shapes, &low_camera, scale)?;
         let stats = PendingStats::read_all(gpu, pending)?;
         let receivers = Receivers::from_stats(&gb, &stats[0], &shapes);
         let low_receivers = low_gb.as_ref().map(|l| Receivers::from_stats(l, &stats[1], &shapes));
@@ -182,6 +232,30 @@ impl Frame {
         )?;
         gpu.submit(encoder);
         Ok(frame)
+    }
+
+    /// Submits both G-buffers (the low one at `low_camera` when `scale` is not 1) with their
+    /// receivers reduced on the GPU: the frame's first submission.
+    fn submit_reduced(
+        &self,
+        gpu: &Gpu,
+        lights: &[ShadeLight],
+        shapes: &[LightShape],
+        low_camera: &scene::Camera,
+        scale: u32,
+    ) -> Result<(gpu::GBuffer, Option<gpu::GBuffer>, Vec<PendingStats>), GpuError> {
+        let ambient = Some(&self.decomposition.ambient_sh);
+        let weber = WeberInput { lights, ambient, fraction: WEBER_FRACTION };
+        let mut encoder = gpu.encoder("frame g-buffers");
+        let gb = self.gbuffer.record(gpu, &mut encoder, &self.geometry, &self.scene.camera)?;
+        let low_gb =
+            (scale != 1).then(|| self.gbuffer.record(gpu, &mut encoder, &self.geometry, low_camera)).transpose()?;
+        let mut pending = vec![self.reductions[0].record(gpu, &mut encoder, &gb, shapes, Some(weber))?];
+        if let Some(l) = &low_gb {
+            pending.push(self.reductions[1].record(gpu, &mut encoder, l, shapes, Some(weber))?);
+        }
+        gpu.submit(encoder);
+        Ok((gb, low_gb, pending))
     }
 
     /// The same frame with its receivers made on the CPU from the G-buffers' points mapped back
@@ -249,7 +323,7 @@ impl Frame {
             settings,
         )?;
         reports.extend(split.indirect_reports);
-        Ok(RenderedFrame { texture: split.texture, reports })
+        Ok(RenderedFrame { texture: split.texture, reports, gated: None })
     }
 
     /// [`Frame::render`] waited for: the wall time of the whole frame (CPU work included) and
@@ -263,4 +337,17 @@ impl Frame {
         gpu.wait(None)?;
         Ok((start.elapsed(), texture))
     }
+}
+
+/// The box around every vertex of `scene`'s objects at their current poses, `None` for none.
+fn scene_bounds(scene: &scene::Scene) -> Option<(glam::Vec3, glam::Vec3)> {
+    let (lo, hi) = scene
+        .objects
+        .iter()
+        .flat_map(|o| &o.mesh.positions)
+        .filter(|p| p.is_finite())
+        .fold((glam::Vec3::splat(f32::INFINITY), glam::Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| {
+            (lo.min(*p), hi.max(*p))
+        });
+    (lo.is_finite() && hi.is_finite()).then_some((lo, hi))
 }

@@ -60,16 +60,21 @@ pub fn run(args: &FrameArgs) -> Result<(), String> {
     let scales: &[(&str, u32)] =
         if args.json { &[("", args.scale)] } else { &[("full", 1), ("half", 2), ("quarter", 4)] };
     for &(name, scale) in scales {
-        let mut reports = Vec::new();
+        let mut last = None;
         let stats = measure_frames(&gpu, args.repeats, |k| -> Result<(), gpu::GpuError> {
             if let Some(object) = moving {
                 let offset = animation_offset(frame.rest(), object, k);
                 frame.move_object(&gpu, object, offset)?;
             }
-            reports = frame.render(&gpu, scale)?.reports;
+            last = Some(frame.render(&gpu, scale)?);
             Ok(())
         })
         .map_err(|e| e.to_string())?;
+        // the lights the GPU skipped, read after the measured frames have finished
+        let reports = match last {
+            Some(r) => r.finish_reports(&gpu).map_err(|e| e.to_string())?.1,
+            None => Vec::new(),
+        };
         // what the last frame skipped and why
         let skipped = gpu::skip_reasons(&reports);
         if args.json {

@@ -6,8 +6,9 @@
 //! adds every representative's transfer where its map says the object blocks it into a
 //! darkening buffer (the paper's blending pass per source, folded into a loop); last the
 //! resolve: the object shaded by its SH9 irradiance, the rest the photograph less the darkening
-//! (HDR: in radiance, then the camera response; LDR: in codes). A frame waits three times
-//! (maps, masks, resolve), not once a representative.
+//! (HDR: in radiance, then the camera response; LDR: in codes). `GpuCompositor::record` records
+//! the whole frame into the caller's encoder (no submission, wait or readback);
+//! `GpuCompositor::composite` measures the same stages, each waited for.
 //!
 //! Shaders: `shaders/differential-composite/`.
 
@@ -220,7 +221,9 @@ impl GpuCompositor {
     }
 
     /// Composites `frame` (made by `c.frame`) for `object` in `mode`: the 8-bit image, where
-    /// the time went (`cpu` is `frame`'s own) and the shadow maps' views.
+    /// the time went (`cpu` is `frame`'s own) and the shadow maps' views. The measured form of
+    /// [`GpuCompositor::record`]: the same stages, each in a submission of its own, waited for
+    /// and timed, then the image read back.
     ///
     /// # Errors
     /// GPU failures.
@@ -233,36 +236,105 @@ impl GpuCompositor {
         mode: Mode,
         settings: &GpuSettings,
     ) -> Result<(Vec<[u8; 3]>, FrameTimes, MapWork), GpuError> {
-        let (w, h) = self.size;
         let mut times = FrameTimes { cpu: frame.cpu(), ..FrameTimes::default() };
-        // the G-buffer of the reconstruction with the object (its index: after the patches)
+        let stage = |label, record: &mut dyn FnMut(&mut wgpu::CommandEncoder) -> Result<(), GpuError>| {
+            let t = Instant::now();
+            let mut encoder = gpu.encoder(label);
+            record(&mut encoder)?;
+            gpu.submit_and_wait(encoder)?;
+            Ok::<_, GpuError>(t.elapsed())
+        };
+        let mut gb = None;
+        times.gbuffer = stage("composite g-buffer", &mut |e| {
+            gb = Some(self.record_gbuffer(gpu, e, c, object)?);
+            Ok(())
+        })?;
+        let gb = gb.ok_or_else(|| GpuError::Failed("composite: no G-buffer".into()))?;
+        let mut maps = None;
+        times.shadow_maps = stage("composite maps", &mut |e| {
+            maps = Some(self.record_maps(gpu, e, c, frame, object, settings)?);
+            Ok(())
+        })?;
+        let maps = maps.ok_or_else(|| GpuError::Failed("composite: no maps".into()))?;
+        times.masks = stage("composite masks", &mut |e| {
+            self.record_masks(gpu, e, c, frame, mode, &gb, &maps);
+            Ok(())
+        })?;
         let t = Instant::now();
+        let mut encoder = gpu.encoder("composite resolve");
+        self.record_resolve(gpu, &mut encoder, c, &gb, frame, object, mode);
+        gpu.submit_and_wait(encoder)?;
+        let image = self.read_output(gpu)?;
+        times.resolve = t.elapsed();
+        Ok((image, times, maps.work))
+    }
+
+    /// Records the whole composite of `frame` for `object` in `mode` into `encoder`, without
+    /// submitting: the G-buffer of the reconstruction with the object, every representative's
+    /// map, the masks and darkening, the resolve into [`GpuCompositor::output`] (the 8-bit
+    /// image, a `u32` per pixel, RGB in its low bytes). No submission, wait or readback: what a
+    /// renderer's frame calls. Returns the maps' work.
+    ///
+    /// # Errors
+    /// GPU failures; sizes beyond the device's limits.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        c: &Compositor,
+        frame: &Frame,
+        object: &SyntheticObject,
+        mode: Mode,
+        settings: &GpuSettings,
+    ) -> Result<MapWork, GpuError> {
+        let gb = self.record_gbuffer(gpu, encoder, c, object)?;
+        let maps = self.record_maps(gpu, encoder, c, frame, object, settings)?;
+        self.record_masks(gpu, encoder, c, frame, mode, &gb, &maps);
+        self.record_resolve(gpu, encoder, c, &gb, frame, object, mode);
+        Ok(maps.work)
+    }
+
+    /// The composite's output once its encoder has run: a `u32` per pixel, row-major, RGB in
+    /// its low three bytes (`STORAGE | COPY_SRC`).
+    #[must_use]
+    pub fn output(&self) -> &wgpu::Buffer {
+        &self.out
+    }
+
+    /// Reads [`GpuCompositor::output`] back (its work submitted): a wait.
+    ///
+    /// # Errors
+    /// GPU failures.
+    pub fn read_output(&self, gpu: &Gpu) -> Result<Vec<[u8; 3]>, GpuError> {
+        let bytes = gpu::read_buffer(gpu, &self.out)?;
+        Ok(bytes.chunks_exact(4).map(|p| [p[0], p[1], p[2]]).collect())
+    }
+
+    /// The G-buffer of the reconstruction with the object (its index: after the patches).
+    fn record_gbuffer(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        c: &Compositor,
+        object: &SyntheticObject,
+    ) -> Result<GBuffer, GpuError> {
         let mut scene = c.model.to_scene();
         scene.objects.push(object.to_object());
         let geometry = SceneGeometry::upload(gpu, &scene)?;
-        let gb = self.gbuffer.render(gpu, &geometry, &scene.camera)?;
-        times.gbuffer = t.elapsed();
-        // the representatives' transfers, rep-major
-        let slots = c.prepared.transfers.slots;
-        let mut transfers: Vec<[f32; 4]> = Vec::with_capacity(frame.reps.len().max(1) * slots);
-        for r in &frame.reps {
-            let v = match mode {
-                Mode::Hdr => &r.radiance,
-                Mode::Ldr => &r.intensity,
-            };
-            transfers.extend(v.iter().map(|x| x.extend(0.0).to_array()));
-        }
-        if transfers.is_empty() {
-            transfers.push([0.0; 4]);
-        }
-        let transfer_buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("transfers"),
-            contents: bytemuck::cast_slice(&transfers),
-            usage: wgpu::BufferUsages::STORAGE,
-        });
-        let mut clear = gpu.encoder("clear darkening");
-        clear.clear_buffer(&self.darkening, 0, None);
-        gpu.submit_and_wait(clear)?;
+        self.gbuffer.record(gpu, encoder, &geometry, &scene.camera)
+    }
+
+    /// Every representative's map, into layers of as few texture arrays as the adapter allows.
+    fn record_maps(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        c: &Compositor,
+        frame: &Frame,
+        object: &SyntheticObject,
+        settings: &GpuSettings,
+    ) -> Result<Maps, GpuError> {
         let casters: Vec<[Vec3; 3]> = {
             let m = object.shadow_mesh(settings.shadow_detail);
             (0..m.indices.len()).map(|t| m.triangle(t)).collect()
@@ -274,15 +346,11 @@ impl GpuCompositor {
             subdivide_angle: None,
             ..ShadowSettings::default()
         };
-        // every map in one submission, into layers of as few texture arrays as the adapter
-        // allows; then every mask and its share of the darkening, one dispatch per array
-        let t = Instant::now();
         let lights: Vec<(ShadowLight, Technique)> = frame.reps.iter().map(|r| settings.map_light(c, r)).collect();
         let limit = gpu.device.limits().max_texture_array_layers;
         let views: Vec<u32> = lights.iter().map(|(l, t)| ShadowMapper::view_count(l, *t)).collect();
         let batches = batches(&views, settings.layers_per_array.map_or(limit, |n| n.min(limit)));
         let res = map_settings.resolution;
-        let mut encoder = gpu.encoder("composite maps");
         let mut arrays = Vec::with_capacity(batches.len());
         let mut params: Vec<Vec<shadowmap_paraboloid::MapParams>> = Vec::with_capacity(batches.len());
         let mut work = MapWork::default();
@@ -294,12 +362,13 @@ impl GpuCompositor {
             for (light, technique) in &lights[first..end] {
                 let map = self.mapper.record(
                     gpu,
-                    &mut encoder,
+                    encoder,
                     &casters,
                     light,
                     *technique,
                     &map_settings,
                     Some((&array, layer)),
+                    shadowmap_paraboloid::OnGpu::default(),
                 )?;
                 mine.push(map.lookup_params(0.0, layer));
                 layer += map.views.len() as u32;
@@ -314,13 +383,43 @@ impl GpuCompositor {
             arrays.push(array);
             params.push(mine);
         }
-        gpu.submit_and_wait(encoder)?;
-        times.shadow_maps = t.elapsed();
-        let t = Instant::now();
+        Ok(Maps { arrays, params, batches, work })
+    }
+
+    /// The darkening cleared, then every mask and its share of it, one dispatch per array.
+    #[allow(clippy::too_many_arguments)]
+    fn record_masks(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        c: &Compositor,
+        frame: &Frame,
+        mode: Mode,
+        gb: &GBuffer,
+        maps: &Maps,
+    ) {
+        let (w, h) = self.size;
+        // the representatives' transfers, rep-major
+        let slots = c.prepared.transfers.slots;
+        let mut transfers: Vec<[f32; 4]> = Vec::with_capacity(frame.reps.len().max(1) * slots);
+        for r in &frame.reps {
+            let v = match mode {
+                Mode::Hdr => &r.radiance,
+                Mode::Ldr => &r.intensity,
+            };
+            transfers.extend(v.iter().map(|x| x.extend(0.0).to_array()));
+        }
+        if transfers.is_empty() {
+            transfers.push([0.0; 4]);
+        }
+        let buffer = |label, contents: &[u8], usage| {
+            gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+        };
+        let transfer_buffer = buffer("transfers", bytemuck::cast_slice(&transfers), wgpu::BufferUsages::STORAGE);
+        encoder.clear_buffer(&self.darkening, 0, None);
         let position = gb.position.create_view(&wgpu::TextureViewDescriptor::default());
         let normal = gb.geometric_normal.create_view(&wgpu::TextureViewDescriptor::default());
-        let mut encoder = gpu.encoder("composite masks");
-        for ((array, mine), &(first, _)) in arrays.iter().zip(&params).zip(&batches) {
+        for ((array, mine), &(first, _)) in maps.arrays.iter().zip(&maps.params).zip(&maps.batches) {
             let uniform = MaskParams {
                 width: w,
                 height: h,
@@ -329,11 +428,8 @@ impl GpuCompositor {
                 first_rep: first as u32,
                 pad: [0; 3],
             };
-            let buffer = |label, contents: &[u8], usage| {
-                gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
-            };
             let uniform = buffer("mask params", bytemuck::bytes_of(&uniform), wgpu::BufferUsages::UNIFORM);
-            let maps = buffer("mask maps", bytemuck::cast_slice(mine), wgpu::BufferUsages::STORAGE);
+            let params = buffer("mask maps", bytemuck::cast_slice(mine), wgpu::BufferUsages::STORAGE);
             let depth = array.create_view(&wgpu::TextureViewDescriptor {
                 dimension: Some(wgpu::TextureViewDimension::D2Array),
                 aspect: wgpu::TextureAspect::DepthOnly,
@@ -346,7 +442,7 @@ impl GpuCompositor {
                     wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 1, resource: self.pixels.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 2, resource: transfer_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 3, resource: maps.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 3, resource: params.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&depth) },
                     wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&position) },
                     wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::TextureView(&normal) },
@@ -358,23 +454,21 @@ impl GpuCompositor {
             pass.set_bind_group(0, &bind, &[]);
             pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
         }
-        gpu.submit_and_wait(encoder)?;
-        times.masks = t.elapsed();
-        let t = Instant::now();
-        let image = self.resolve(gpu, c, &gb, frame, object, mode)?;
-        times.resolve = t.elapsed();
-        Ok((image, times, work))
     }
 
-    fn resolve(
+    /// The object shaded by its SH9 irradiance, the rest the photograph less the darkening,
+    /// into [`GpuCompositor::output`].
+    #[allow(clippy::too_many_arguments)]
+    fn record_resolve(
         &self,
         gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
         c: &Compositor,
         gb: &GBuffer,
         frame: &Frame,
         object: &SyntheticObject,
         mode: Mode,
-    ) -> Result<Vec<[u8; 3]>, GpuError> {
+    ) {
         let (w, h) = self.size;
         let irradiance = frame.object_irradiance.irradiance_coefficients().map(|v| v.extend(0.0).to_array());
         let params = ResolveParams {
@@ -406,17 +500,20 @@ impl GpuCompositor {
                 wgpu::BindGroupEntry { binding: 6, resource: self.out.as_entire_binding() },
             ],
         });
-        let mut encoder = gpu.encoder("composite resolve");
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor::default());
-            pass.set_pipeline(&self.resolve);
-            pass.set_bind_group(0, &bind, &[]);
-            pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
-        }
-        gpu.submit_and_wait(encoder)?;
-        let bytes = gpu::read_buffer(gpu, &self.out)?;
-        Ok(bytes.chunks_exact(4).map(|p| [p[0], p[1], p[2]]).collect())
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor::default());
+        pass.set_pipeline(&self.resolve);
+        pass.set_bind_group(0, &bind, &[]);
+        pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
     }
+}
+
+/// A frame's maps as recorded: the texture arrays, each array's maps' lookup parameters, the
+/// batches (first representative, layers) and the work.
+struct Maps {
+    arrays: Vec<wgpu::Texture>,
+    params: Vec<Vec<shadowmap_paraboloid::MapParams>>,
+    batches: Vec<(usize, u32)>,
+    work: MapWork,
 }
 
 fn pack(p: [u8; 3]) -> u32 {

@@ -323,3 +323,28 @@ fn hemispherical_sources_render_one_paraboloid_view_and_cubes_six() {
     let differ = paraboloid.iter().zip(&cube).filter(|(a, b)| (0..3).any(|ch| a[ch].abs_diff(b[ch]) > 2)).count();
     assert!((differ as f64) < 0.01 * paraboloid.len() as f64, "{differ} pixels differ");
 }
+
+#[test]
+fn the_composite_recorded_into_one_encoder_equals_the_measured_one() {
+    // the real-time path: every stage recorded into the caller's encoder, nothing submitted,
+    // waited for or read back while recording; the measured path waits after each stage
+    let s = room();
+    let c = &s.compositor;
+    let (g, gc) = gpu();
+    for at in [Vec3::new(0.0, 0.3, 0.5), Vec3::new(0.4, 0.3, 0.2)] {
+        let object = sphere(s, at);
+        let frame = c.frame(&object, 20);
+        for mode in [Mode::Hdr, Mode::Ldr] {
+            let settings = GpuSettings::default();
+            let (measured, _, work) = gc.composite(g, c, &frame, &object, mode, &settings).unwrap();
+            let mut encoder = g.encoder("composite");
+            let before = g.counters();
+            let recorded_work = gc.record(g, &mut encoder, c, &frame, &object, mode, &settings).unwrap();
+            let during = g.counters() - before;
+            assert_eq!((during.submits, during.waits, during.readback_bytes, during.pipelines), (0, 0, 0, 0));
+            g.submit(encoder);
+            assert_eq!(recorded_work, work);
+            assert!(gc.read_output(g).unwrap() == measured, "{at} {mode:?}: the recorded composite differs");
+        }
+    }
+}

@@ -104,7 +104,8 @@ impl ResolvePass {
     }
 
     /// Records the resolve of `acc` into `target` (a visibility layer): `params` is the
-    /// uniform at binding 0, `extra` any further bindings the shader reads.
+    /// uniform at binding 0, `extra` any further bindings the shader reads; `call`: the
+    /// triangle as call `k` of a light's [`crate::Calls`] (gated), or `None` to draw it.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
@@ -114,6 +115,7 @@ impl ResolvePass {
         acc: &Accumulator,
         params: &[u8],
         extra: &[(u32, wgpu::BindingResource<'_>)],
+        call: Option<(&crate::Calls, usize)>,
         target: &wgpu::TextureView,
     ) {
         let buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -138,6 +140,9 @@ impl ResolvePass {
             entries: &entries,
         });
         let clear = wgpu::LoadOp::Clear(wgpu::Color::WHITE);
-        crate::fullscreen::record(encoder, &self.pipeline, &bind, target, clear);
+        match call {
+            Some(call) => crate::fullscreen::record_calls(encoder, &self.pipeline, &bind, target, clear, call),
+            None => crate::fullscreen::record(encoder, &self.pipeline, &bind, target, clear),
+        }
     }
 }

@@ -94,6 +94,20 @@ pub fn record(
     target: &wgpu::TextureView,
     load: wgpu::LoadOp<wgpu::Color>,
 ) {
+    let calls = crate::Calls::direct(vec![crate::Indirect::draw(0..3)]);
+    record_calls(encoder, pipeline, bind, target, load, (&calls, 0));
+}
+
+/// As [`record`], the triangle drawn as call `k` of `calls` (`Indirect::draw(0..3)`), gated or
+/// not: a gated-off light's pass only applies `load`.
+pub fn record_calls(
+    encoder: &mut wgpu::CommandEncoder,
+    pipeline: &wgpu::RenderPipeline,
+    bind: &wgpu::BindGroup,
+    target: &wgpu::TextureView,
+    load: wgpu::LoadOp<wgpu::Color>,
+    (calls, k): (&crate::Calls, usize),
+) {
     let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some("full-screen pass"),
         color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -106,5 +120,5 @@ pub fn record(
     });
     pass.set_pipeline(pipeline);
     pass.set_bind_group(0, bind, &[]);
-    pass.draw(0..3, 0..1);
+    calls.draw(&mut pass, k);
 }

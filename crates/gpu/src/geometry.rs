@@ -271,24 +271,33 @@ impl ShadowGeometry {
     /// Draws the chunks whose index `visible` accepts, merging neighbours into one draw call.
     /// Returns the number of triangles drawn.
     pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, visible: impl Fn(usize) -> bool) -> u32 {
+        self.set_vertices(pass);
+        let (runs, drawn) = self.runs(visible);
+        for r in runs {
+            pass.draw(r, 0..1);
+        }
+        drawn
+    }
+
+    /// Binds the vertices at slot 0 for drawing [`ShadowGeometry::runs`].
+    pub fn set_vertices(&self, pass: &mut wgpu::RenderPass<'_>) {
         pass.set_vertex_buffer(0, self.vertices.slice(..));
-        let mut run: Option<(u32, u32)> = None;
+    }
+
+    /// The vertex ranges of the chunks whose index `visible` accepts, neighbours merged (one
+    /// draw call each), and their triangles.
+    #[must_use]
+    pub fn runs(&self, visible: impl Fn(usize) -> bool) -> (Vec<std::ops::Range<u32>>, u32) {
+        let mut runs: Vec<std::ops::Range<u32>> = Vec::new();
         let mut drawn = 0;
         for c in self.chunks.iter().enumerate().filter(|(k, _)| visible(*k)).map(|(_, c)| c) {
             drawn += c.vertex_count / 3;
-            run = match run {
-                Some((start, end)) if end == c.first_vertex => Some((start, end + c.vertex_count)),
-                Some((start, end)) => {
-                    pass.draw(start..end, 0..1);
-                    Some((c.first_vertex, c.first_vertex + c.vertex_count))
-                }
-                None => Some((c.first_vertex, c.first_vertex + c.vertex_count)),
-            };
+            match runs.last_mut() {
+                Some(r) if r.end == c.first_vertex => r.end += c.vertex_count,
+                _ => runs.push(c.first_vertex..c.first_vertex + c.vertex_count),
+            }
         }
-        if let Some((start, end)) = run {
-            pass.draw(start..end, 0..1);
-        }
-        drawn
+        (runs, drawn)
     }
 }
 

@@ -15,6 +15,7 @@ pub mod accumulate;
 pub mod ambient;
 mod context;
 pub mod fullscreen;
+mod gate;
 mod gbuffer;
 mod geometry;
 mod interleave;
@@ -31,21 +32,25 @@ mod upsample;
 
 pub use ambient::{DfgTable, PrefilterSettings, PrefilteredMap, SpecularAmbient};
 pub use context::{ADAPTER_ENV, Gpu, GpuCounters, GpuError, adapters, describe_adapter, pick_adapter};
+pub use gate::{Calls, Gate, GatedArgs, GpuStats, Indirect};
 pub use gbuffer::{
     GBUFFER_FORMAT, GBuffer, GBufferPass, PointsRead, view_projection, view_projection_infinite,
     view_projection_reverse,
 };
 pub use geometry::{Chunk, SceneGeometry, ShadowGeometry, scene_triangles};
 pub use interleave::{InterleavePass, InterleavedFrame, MAX_SETS, interleave_set, interleave_tile, render_interleaved};
-pub use readback::{PendingRead, read_buffer, read_mapped, read_mapped_all, read_texture_f32, read_texture_rgba};
-pub use receivers::{PendingStats, ReceiverReduction, ReceiverStats, WeberInput};
+pub use readback::{
+    MappingRead, PendingRead, read_buffer, read_mapped, read_mapped_all, read_texture_f32, read_texture_rgba,
+};
+pub use receivers::{MappedStats, PendingStats, ReceiverReduction, ReceiverStats, WeberInput};
 pub use shade::{Background, HDR_FORMAT, ShadeLight, ShadeParams, ShadingPass, Visibility, read_hdr};
 pub use split::{SplitFrame, SplitImage, SplitPasses, SplitSettings, indirect_camera, record_split, render_split};
 pub use supersample::RotatedGrid;
 pub use target::{layer_view, render_target};
 pub use technique::{
     LightShape, PrecomputedVisibility, Receivers, ShadowPassReport, ShadowTechnique, WEBER_FRACTION,
-    WEBER_MAX_RECEIVERS, culled_totals, record_visibility, render_visibility, skip_reasons, totals, weber_negligible,
+    WEBER_MAX_RECEIVERS, conservative_bounds, culled_totals, record_visibility, render_visibility, skip_reasons,
+    totals, weber_negligible,
 };
 pub use timer::Clock;
 pub use upsample::{JointBilateral, UpsamplePass};

@@ -15,27 +15,58 @@ pub fn read_mapped(gpu: &Gpu, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError
 /// # Errors
 /// [`GpuError::Failed`] when the wait or a mapping fails.
 pub fn read_mapped_all(gpu: &Gpu, buffers: &[&wgpu::Buffer]) -> Result<Vec<Vec<u8>>, GpuError> {
-    let receivers: Vec<_> = buffers
-        .iter()
-        .map(|buffer| {
-            let (tx, rx) = std::sync::mpsc::channel();
-            buffer.map_async(wgpu::MapMode::Read, .., move |r| {
-                let _ = tx.send(r);
-            });
-            rx
-        })
-        .collect();
+    let mapping = MappingRead::start(gpu, buffers.iter().map(|b| (*b).clone()).collect());
     gpu.wait(None)?;
-    let mut out = Vec::with_capacity(buffers.len());
-    for (buffer, rx) in buffers.iter().zip(receivers) {
-        gpu.count_readback(buffer.size());
-        rx.recv()
-            .map_err(|e| GpuError::Failed(e.to_string()))?
-            .map_err(|e| GpuError::Failed(format!("mapping a readback buffer: {e}")))?;
-        out.push(buffer.get_mapped_range(..).map_err(|e| GpuError::Failed(e.to_string()))?.to_vec());
-        buffer.unmap();
+    mapping.finish(gpu)
+}
+
+/// Buffers whose mapping was asked for without waiting ([`MappingRead::start`]): a frame's
+/// small results, read once the frame has finished (after the caller's own wait, or the next
+/// frame), never a stall of the frame that made them.
+pub struct MappingRead {
+    buffers: Vec<wgpu::Buffer>,
+    done: Vec<std::sync::mpsc::Receiver<Result<(), wgpu::BufferAsyncError>>>,
+}
+
+impl MappingRead {
+    /// Asks for every one of `buffers` (which need `MAP_READ`, their work submitted) to be
+    /// mapped, and returns at once. Their bytes count as read back now.
+    #[must_use]
+    pub fn start(gpu: &Gpu, buffers: Vec<wgpu::Buffer>) -> Self {
+        for b in &buffers {
+            gpu.count_readback(b.size());
+        }
+        let done = buffers
+            .iter()
+            .map(|buffer| {
+                let (tx, rx) = std::sync::mpsc::channel();
+                buffer.map_async(wgpu::MapMode::Read, .., move |r| {
+                    let _ = tx.send(r);
+                });
+                rx
+            })
+            .collect();
+        Self { buffers, done }
     }
-    Ok(out)
+
+    /// The buffers' bytes, in order, when the device has finished them; it polls without
+    /// blocking and never waits.
+    ///
+    /// # Errors
+    /// [`GpuError::Failed`] when the work has not finished yet (wait for it first) or a
+    /// mapping failed.
+    pub fn finish(self, gpu: &Gpu) -> Result<Vec<Vec<u8>>, GpuError> {
+        gpu.device.poll(wgpu::PollType::Poll).map_err(|e| GpuError::Failed(e.to_string()))?;
+        let mut out = Vec::with_capacity(self.buffers.len());
+        for (buffer, rx) in self.buffers.iter().zip(self.done) {
+            rx.try_recv()
+                .map_err(|_| GpuError::Failed("a readback is not finished: wait for its frame first".into()))?
+                .map_err(|e| GpuError::Failed(format!("mapping a readback buffer: {e}")))?;
+            out.push(buffer.get_mapped_range(..).map_err(|e| GpuError::Failed(e.to_string()))?.to_vec());
+            buffer.unmap();
+        }
+        Ok(out)
+    }
 }
 
 /// Copies `buffer` (which needs `COPY_SRC`) back to the CPU.

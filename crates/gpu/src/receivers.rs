@@ -5,6 +5,7 @@
 //! (`Receivers::new`, `Receivers::any_faces`) is the reference it is tested against.
 
 use crate::context::{Gpu, GpuError};
+use crate::gate::GpuStats;
 use crate::gbuffer::GBuffer;
 use crate::shade::ShadeLight;
 use crate::technique::LightShape;
@@ -33,6 +34,15 @@ pub struct ReceiverStats {
 }
 
 impl ReceiverStats {
+    /// Why light `k` got no shadow pass where a frame gated its lights by these statistics
+    /// ([`crate::GpuStats::gate`]): no visible receiver faces it, or Weber's law finds it
+    /// negligible; `None` when it had its pass.
+    #[must_use]
+    pub fn skip_reason(&self, k: usize) -> Option<String> {
+        let faced = self.faces.get(k).copied().unwrap_or(false);
+        crate::technique::why_skipped(faced, self.negligible.get(k).copied().unwrap_or(false))
+    }
+
     /// Bytes mapped back per reduction.
     pub const BYTES: u64 = 8 * 4 + 16 + 4 * (ReceiverReduction::MAX_LIGHTS as u64 / 32) + 32;
 }
@@ -94,6 +104,7 @@ pub struct ReceiverReduction {
     weber_totals: wgpu::ComputePipeline,
     weber_greedy: wgpu::ComputePipeline,
     weber_state: wgpu::Buffer,
+    gate: wgpu::ComputePipeline,
     buffers: RefCell<Option<Buffers>>,
 }
 
@@ -103,6 +114,13 @@ pub struct PendingStats {
     lights: usize,
     // Weber's result and its light count, when asked
     weber: Option<(wgpu::Buffer, usize)>,
+    on_gpu: GpuStats,
+}
+
+/// A reduction's result being mapped ([`PendingStats::map`]), to be read once its frame is done.
+pub struct MappedStats {
+    pending: PendingStats,
+    mapping: crate::readback::MappingRead,
 }
 
 impl ReceiverReduction {
@@ -115,6 +133,7 @@ impl ReceiverReduction {
         let module =
             crate::shader::module(&gpu.device, "receivers", include_str!("../../../shaders/gpu/receivers.wgsl"), &[]);
         let weber = crate::shader::module(&gpu.device, "weber", include_str!("../../../shaders/gpu/weber.wgsl"), &[]);
+        let gate = crate::shader::module(&gpu.device, "gate", include_str!("../../../shaders/gpu/gate.wgsl"), &[]);
         let pipeline_of = |module: &wgpu::ShaderModule, entry| {
             gpu.compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(entry),
@@ -154,6 +173,7 @@ impl ReceiverReduction {
             weber_totals: pipeline_of(&weber, "totals_pass"),
             weber_greedy: pipeline_of(&weber, "greedy"),
             weber_state,
+            gate: pipeline_of(&gate, "gate"),
             buffers: RefCell::new(None),
         }
     }
@@ -305,7 +325,13 @@ impl ReceiverReduction {
                     .map(|b| (b, input.lights.len()))
             })
             .transpose()?;
-        Ok(PendingStats { read, lights: lights.len(), weber })
+        let on_gpu = GpuStats {
+            stats: self.stats.clone(),
+            weber: weber.as_ref().map(|_| self.weber_state.clone()),
+            gate: self.gate.clone(),
+            first: 0,
+        };
+        Ok(PendingStats { read, lights: lights.len(), weber, on_gpu })
     }
 
     /// Records Weber's passes and the copy of their result.
@@ -396,6 +422,21 @@ fn weber_subset((w, h): (u32, u32)) -> (u32, u32, u32) {
 }
 
 impl PendingStats {
+    /// The result where it is, on the GPU: what gates the frame's lights
+    /// ([`GpuStats::gate`]) and what orthographic maps take their focus from, with no wait.
+    #[must_use]
+    pub fn on_gpu(&self) -> &GpuStats {
+        &self.on_gpu
+    }
+
+    /// Asks for the result to be mapped (its encoder submitted) and returns at once: read it
+    /// with [`MappedStats::finish`] once the frame has finished, without a wait of its own.
+    #[must_use]
+    pub fn map(self, gpu: &Gpu) -> MappedStats {
+        let buffers = std::iter::once(self.read.clone()).chain(self.weber.as_ref().map(|w| w.0.clone())).collect();
+        MappedStats { mapping: crate::readback::MappingRead::start(gpu, buffers), pending: self }
+    }
+
     /// Maps the result (its encoder submitted): a wait.
     ///
     /// # Errors
@@ -447,5 +488,19 @@ impl PendingStats {
             faces,
             negligible,
         })
+    }
+}
+
+impl MappedStats {
+    /// The statistics, once the work that made them has finished (the caller waited for its
+    /// frame, or a later one): it never waits.
+    ///
+    /// # Errors
+    /// [`GpuError::Failed`] when the work has not finished or the mapping failed.
+    pub fn finish(self, gpu: &Gpu) -> Result<ReceiverStats, GpuError> {
+        let mut bytes = self.mapping.finish(gpu)?.into_iter();
+        let stats = bytes.next().unwrap_or_default();
+        let weber = bytes.next();
+        self.pending.decode(&stats, weber.as_deref())
     }
 }

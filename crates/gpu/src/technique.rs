@@ -11,6 +11,7 @@
 //! submitted, waited for and timed on its own, for measurement.
 
 use crate::context::{Gpu, GpuError};
+use crate::gate::{Gate, GpuStats};
 use crate::gbuffer::GBuffer;
 use crate::shade::Visibility;
 use crate::timer::Clock;
@@ -98,6 +99,9 @@ pub struct Receivers<'a> {
     /// Lights known to be faced (or not) by a visible receiver without the points (from a
     /// [`crate::ReceiverStats`]); [`Receivers::any_faces`] answers from here first.
     pub facing: Vec<(LightShape, bool)>,
+    /// The GPU's reduction of these receivers, left there ([`Receivers::on_gpu`]): lights are
+    /// gated by it and orthographic maps take their focus from it, so the CPU never waits.
+    pub on_gpu: Option<GpuStats>,
 }
 
 impl<'a> Receivers<'a> {
@@ -115,7 +119,18 @@ impl<'a> Receivers<'a> {
             bounds: lo.is_finite().then_some((lo, hi)),
             focus: view_focus(points),
             facing: Vec::new(),
+            on_gpu: None,
         }
+    }
+
+    /// The receivers of `gbuffer` as the CPU can know them without waiting: `bounds`, a box
+    /// that holds every visible point (e.g. [`conservative_bounds`] of the scene and the
+    /// camera), and the GPU's reduction of them left on the GPU (`stats`,
+    /// [`crate::PendingStats::on_gpu`]), which gates each light's passes and gives maps their
+    /// focus. [`Receivers::any_faces`] answers yes for every light: the GPU decides.
+    #[must_use]
+    pub fn on_gpu(gbuffer: &'a GBuffer, bounds: Option<(Vec3, Vec3)>, stats: GpuStats) -> Self {
+        Self { gbuffer, points: &[], bounds, focus: None, facing: Vec::new(), on_gpu: Some(stats) }
     }
 
     /// The receivers of `gbuffer` as the GPU reduced them ([`crate::ReceiverReduction`], for
@@ -129,6 +144,7 @@ impl<'a> Receivers<'a> {
             bounds: stats.bounds,
             focus: stats.mean.zip(stats.radius),
             facing: lights.iter().copied().zip(stats.faces.iter().copied()).collect(),
+            on_gpu: None,
         }
     }
 
@@ -136,11 +152,43 @@ impl<'a> Receivers<'a> {
     /// faces lights nothing, so it needs no shadow pass.
     #[must_use]
     pub fn any_faces(&self, light: &LightShape) -> bool {
+        if self.on_gpu.is_some() {
+            return true;
+        }
         if let Some((_, faces)) = self.facing.iter().find(|(l, _)| l == light) {
             return *faces;
         }
         self.points.iter().any(|(p, n)| p.is_finite() && light.reaches(*p, *n))
     }
+}
+
+/// A box that holds every point `camera` can see of a scene inside `scene` (a box), or `None`
+/// when nothing of it is in front of the camera: the scene's box clipped to the box of the view
+/// pyramid that reaches its farthest corner, widened by a millionth of its diagonal against the
+/// rounding of interpolated positions. What the CPU knows of the receivers without the G-buffer.
+#[must_use]
+pub fn conservative_bounds(scene: (Vec3, Vec3), camera: &scene::Camera) -> Option<(Vec3, Vec3)> {
+    let (lo, hi) = scene;
+    if !(lo.is_finite() && hi.is_finite() && lo.cmple(hi).all()) {
+        return None;
+    }
+    let (right, up, forward) = camera.basis();
+    let corners = (0..8).map(|k| Vec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), hi, lo));
+    let far = corners.map(|c| (c - camera.eye).dot(forward)).fold(f32::NEG_INFINITY, f32::max);
+    if far.is_nan() || far <= 0.0 {
+        return None;
+    }
+    let tx = (camera.hfov_degrees.to_radians() * 0.5).tan();
+    let ty = tx * camera.height as f32 / camera.width.max(1) as f32;
+    let (mut flo, mut fhi) = (camera.eye, camera.eye);
+    for (sx, sy) in [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)] {
+        let c = camera.eye + far * (forward + right * (sx * tx) + up * (sy * ty));
+        flo = flo.min(c);
+        fhi = fhi.max(c);
+    }
+    let margin = Vec3::splat((hi - lo).length() * 1e-6);
+    let (a, b) = (lo.max(flo) - margin, hi.min(fhi) + margin);
+    (a.is_finite() && b.is_finite() && a.cmple(b).all()).then_some((a, b))
 }
 
 /// Sphere around what the camera sees: the mean visible point and the 95th percentile of the
@@ -190,6 +238,11 @@ pub trait ShadowTechnique {
     /// runs in order, so a technique may reuse its scratch targets from light to light. The
     /// report's `time` is zero and its `clock` `None` (the caller times the submission).
     ///
+    /// With a `gate` (the light's, from [`Receivers::on_gpu`]), every draw and dispatch is
+    /// indirect through it ([`crate::Calls`]): where the GPU finds the light needs no pass,
+    /// nothing is drawn and `target` is left as its passes clear it, lit. The report then says
+    /// what would be drawn; what was skipped is known once the frame has run.
+    ///
     /// # Errors
     /// A light the technique does not support; sizes beyond the device's limits.
     fn record(
@@ -198,6 +251,7 @@ pub trait ShadowTechnique {
         encoder: &mut wgpu::CommandEncoder,
         receivers: &Receivers,
         light: &LightShape,
+        gate: Option<Gate<'_>>,
         target: &wgpu::TextureView,
     ) -> Result<ShadowPassReport, GpuError>;
 
@@ -215,7 +269,7 @@ pub trait ShadowTechnique {
     ) -> Result<ShadowPassReport, GpuError> {
         let mut recorded = None;
         let (time, clock) =
-            gpu.measure(|encoder| recorded = Some(self.record(gpu, encoder, receivers, light, target)))?;
+            gpu.measure(|encoder| recorded = Some(self.record(gpu, encoder, receivers, light, None, target)))?;
         let report = recorded.ok_or_else(|| GpuError::Failed(format!("{}: nothing recorded", self.name())))??;
         Ok(ShadowPassReport { time, clock: Some(clock), ..report })
     }
@@ -224,7 +278,13 @@ pub trait ShadowTechnique {
 /// Why a light got no shadow pass, or `None` when it needs one: no visible receiver faces it,
 /// or `negligible` marks it (Weber's law).
 fn skip_reason(receivers: &Receivers, light: &LightShape, negligible: bool) -> Option<String> {
-    if !receivers.any_faces(light) {
+    why_skipped(receivers.any_faces(light), negligible)
+}
+
+/// Why a light whose visible receivers `faced` it (or not) and that Weber's law finds
+/// `negligible` (or not) gets no shadow pass, or `None` when it needs one.
+pub(crate) fn why_skipped(faced: bool, negligible: bool) -> Option<String> {
+    if !faced {
         return Some("no visible receiver faces it".into());
     }
     negligible.then(|| {
@@ -279,7 +339,8 @@ pub fn record_visibility(
     visibility: &Visibility,
 ) -> Result<Vec<ShadowPassReport>, GpuError> {
     each_light(receivers, lights, negligible, visibility, |k, light| {
-        technique.record(gpu, encoder, receivers, light, &visibility.layer(k))
+        let gate = receivers.on_gpu.as_ref().map(|s| s.gate(k));
+        technique.record(gpu, encoder, receivers, light, gate, &visibility.layer(k))
     })
 }
 
@@ -469,6 +530,7 @@ impl ShadowTechnique for PrecomputedVisibility {
         encoder: &mut wgpu::CommandEncoder,
         receivers: &Receivers,
         light: &LightShape,
+        gate: Option<Gate<'_>>,
         target: &wgpu::TextureView,
     ) -> Result<ShadowPassReport, GpuError> {
         use wgpu::util::DeviceExt;
@@ -497,7 +559,9 @@ impl ShadowTechnique for PrecomputedVisibility {
                 wgpu::BindGroupEntry { binding: 1, resource: values.as_entire_binding() },
             ],
         });
-        crate::fullscreen::record(encoder, &self.pipeline, &bind, target, wgpu::LoadOp::Clear(wgpu::Color::WHITE));
+        let calls = crate::Calls::new(gpu, encoder, gate, vec![crate::Indirect::draw(0..3)]);
+        let clear = wgpu::LoadOp::Clear(wgpu::Color::WHITE);
+        crate::fullscreen::record_calls(encoder, &self.pipeline, &bind, target, clear, (&calls, 0));
         Ok(ShadowPassReport::default())
     }
 }
@@ -505,6 +569,51 @@ impl ShadowTechnique for PrecomputedVisibility {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every point of the box the camera can see lies in the bounds, at 1e-3, 1 and 1e4 m;
+    /// nothing in front of the camera and non-finite boxes give none.
+    #[test]
+    fn conservative_bounds_hold_every_visible_point_of_the_box() {
+        for scale in [1e-3f32, 1.0, 1e4] {
+            let camera = scene::Camera {
+                eye: Vec3::new(0.0, 2.0, 6.0) * scale,
+                target: Vec3::ZERO,
+                up: Vec3::Y,
+                hfov_degrees: 50.0,
+                width: 160,
+                height: 90,
+            };
+            let scene = (Vec3::new(-20.0, -1.0, -30.0) * scale, Vec3::new(20.0, 3.0, 2.0) * scale);
+            let (lo, hi) = conservative_bounds(scene, &camera).unwrap();
+            assert!(lo.cmpge(scene.0 - scale * 1e-3).all() && hi.cmple(scene.1 + scale * 1e-3).all());
+            // smaller than the box: the view cuts it
+            assert!((hi - lo).length() < (scene.1 - scene.0).length());
+            let (right, up, forward) = camera.basis();
+            let tx = (camera.hfov_degrees.to_radians() * 0.5).tan();
+            let ty = tx * 90.0 / 160.0;
+            let mut seen = 0;
+            let mut state = 12345u32;
+            let mut next = || {
+                state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+                (state >> 8) as f32 / (1u32 << 24) as f32
+            };
+            for _ in 0..20_000 {
+                let p = scene.0 + (scene.1 - scene.0) * Vec3::new(next(), next(), next());
+                let v = p - camera.eye;
+                let z = v.dot(forward);
+                if z > 0.0 && v.dot(right).abs() <= tx * z && v.dot(up).abs() <= ty * z {
+                    seen += 1;
+                    assert!(p.cmpge(lo).all() && p.cmple(hi).all(), "{p} outside {lo} .. {hi}");
+                }
+            }
+            assert!(seen > 100, "{seen} points seen");
+        }
+        let camera =
+            scene::Camera { eye: Vec3::ZERO, target: Vec3::Z, up: Vec3::Y, hfov_degrees: 60.0, width: 4, height: 4 };
+        assert_eq!(conservative_bounds((Vec3::splat(-3.0), Vec3::new(3.0, 3.0, -1.0)), &camera), None);
+        assert_eq!(conservative_bounds((Vec3::splat(f32::NAN), Vec3::ONE), &camera), None);
+        assert_eq!(conservative_bounds((Vec3::ONE, Vec3::ZERO), &camera), None);
+    }
 
     #[test]
     fn skip_reasons_and_culled_work_add_up_per_kind() {

@@ -30,6 +30,7 @@ impl ShadowTechnique for Unshadowed {
         _: &mut wgpu::CommandEncoder,
         _: &Receivers,
         _: &LightShape,
+        _: Option<gpu::Gate<'_>>,
         _: &wgpu::TextureView,
     ) -> Result<ShadowPassReport, GpuError> {
         Ok(ShadowPassReport::default())
@@ -61,11 +62,12 @@ impl ShadowTechnique for Stripes {
         encoder: &mut wgpu::CommandEncoder,
         receivers: &Receivers,
         light: &LightShape,
+        gate: Option<gpu::Gate<'_>>,
         target: &wgpu::TextureView,
     ) -> Result<ShadowPassReport, GpuError> {
         let values = receivers.points.iter().map(|(p, _)| if p.is_finite() { Self::at(*p) } else { 1.0 }).collect();
         gpu::PrecomputedVisibility::new(gpu, "stripes", receivers.gbuffer.size(), vec![(*light, values)])?
-            .record(gpu, encoder, receivers, light, target)
+            .record(gpu, encoder, receivers, light, gate, target)
     }
 }
 

@@ -378,13 +378,15 @@ pub fn run(map: Option<&Path>, out: &Path, frames: usize, (w, h): (u32, u32)) ->
         let weber = WeberInput { lights: &shade, ambient: Some(&decomposition.ambient_sh), fraction: WEBER_FRACTION };
         let pending = reduction.record(&gpu, &mut encoder, &gbuffer, &shapes, Some(weber))?;
         queue.submit([encoder.finish()]);
-        let stats = pending.read(&gpu)?;
 
-        // every light's visibility recorded into the renderer's encoder, then its shading
-        let receivers = Receivers::from_stats(&gbuffer, &stats, &shapes);
+        // every light's visibility recorded into the renderer's encoder, then its shading: the
+        // reduction stays on the GPU and gates each light's draws (no wait for it); the wedges
+        // are planned for what the CPU knows, the scene's box within the view
+        let bounds = gpu::conservative_bounds(scene_box(&scene), &gbuffer.camera);
+        let receivers = Receivers::on_gpu(&gbuffer, bounds, pending.on_gpu().clone());
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         visibility.record_clear(&mut encoder);
-        gpu::record_visibility(&gpu, &mut encoder, &wedges, &receivers, &shapes, &stats.negligible, &visibility)?;
+        gpu::record_visibility(&gpu, &mut encoder, &wedges, &receivers, &shapes, &[], &visibility)?;
         gpu::fullscreen::record(
             &mut encoder,
             &shade_pipeline,
@@ -410,6 +412,15 @@ pub fn run(map: Option<&Path>, out: &Path, frames: usize, (w, h): (u32, u32)) ->
         written.push(path);
     }
     Ok(written)
+}
+
+/// The box around every vertex of `scene`, at the objects' current poses.
+fn scene_box(scene: &scene::Scene) -> (Vec3, Vec3) {
+    scene
+        .objects
+        .iter()
+        .flat_map(|o| &o.mesh.positions)
+        .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
 }
 
 #[cfg(test)]

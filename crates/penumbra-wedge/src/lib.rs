@@ -20,7 +20,7 @@
 //! let light = LightShape::Distant { direction: glam::Vec3::new(0.3, 1.0, 0.2).normalize(), half_angle: 0.05 };
 //! let vis = gpu::Visibility::new(&gpu, 640, 480, 1).expect("fits");
 //! let report = wedges.write_visibility(&gpu, &Receivers::new(&gbuffer, &points), &light, &vis.layer(0));
-//! // or, in a renderer's frame: wedges.record(&gpu, &mut encoder, &receivers, &light, &layer)
+//! // or, in a renderer's frame: wedges.record(&gpu, &mut encoder, &receivers, &light, None, &layer)
 //! ```
 
 pub mod casters;
@@ -31,7 +31,7 @@ use casters::{Caster, Casters};
 use geometry::reach_along;
 use glam::{Mat4, Vec3};
 use gpu::accumulate::{Accumulator, ResolvePass};
-use gpu::{Gpu, GpuError, LightShape, Receivers, ShadowPassReport, ShadowTechnique};
+use gpu::{Calls, Gpu, GpuError, Indirect, LightShape, Receivers, ShadowPassReport, ShadowTechnique};
 use std::cell::RefCell;
 use wgpu::util::DeviceExt;
 
@@ -457,6 +457,7 @@ impl ShadowTechnique for Wedges {
         encoder: &mut wgpu::CommandEncoder,
         receivers: &Receivers,
         light: &LightShape,
+        gate: Option<gpu::Gate<'_>>,
         target: &wgpu::TextureView,
     ) -> Result<ShadowPassReport, GpuError> {
         let gb = receivers.gbuffer;
@@ -555,6 +556,19 @@ impl ShadowTechnique for Wedges {
             });
             (sum, bind, (bins.tiles_x, h.div_ceil(TILE).max(1)))
         });
+        // volume, footprints, tiles, resolve: gated on the GPU when the frame's lights are
+        let tiles = compute.as_ref().map_or([0, 0, 0], |(_, _, (tx, ty))| [*tx, *ty, 1]);
+        let calls = Calls::new(
+            gpu,
+            encoder,
+            gate,
+            vec![
+                Indirect::draw(0..volume.len() as u32),
+                Indirect::draw(0..footprints.len() as u32),
+                Indirect::Dispatch(tiles),
+                Indirect::draw(0..3),
+            ],
+        );
         {
             {
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -566,28 +580,29 @@ impl ShadowTechnique for Wedges {
                     pass.set_pipeline(&self.volume);
                     pass.set_bind_group(0, &volume_bind, &[]);
                     pass.set_vertex_buffer(0, vb.slice(..));
-                    pass.draw(0..volume.len() as u32, 0..1);
+                    calls.draw(&mut pass, 0);
                 }
                 if let Some(fb) = &footprint_buf {
                     pass.set_pipeline(&self.wedge);
                     pass.set_bind_group(0, &wedge_bind, &[]);
                     pass.set_vertex_buffer(0, fb.slice(..));
-                    pass.draw(0..footprints.len() as u32, 0..1);
+                    calls.draw(&mut pass, 1);
                 }
             }
-            if let Some((_, bind, (tx, ty))) = &compute {
+            if let Some((_, bind, _)) = &compute {
                 let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("wedge tiles"),
                     timestamp_writes: None,
                 });
                 pass.set_pipeline(&self.tiles);
                 pass.set_bind_group(0, bind, &[]);
-                pass.dispatch_workgroups(*tx, *ty, 1);
+                calls.dispatch(&mut pass, 2);
             }
             let sum = compute.as_ref().map_or(&self.no_edge_sum, |(t, _, _)| t).create_view(&Default::default());
             let extra =
                 [(3, wgpu::BindingResource::TextureView(&normal)), (4, wgpu::BindingResource::TextureView(&sum))];
-            self.resolve.record(gpu, encoder, gb, acc, bytemuck::cast_slice(&light_params), &extra, target);
+            let params = bytemuck::cast_slice(&light_params);
+            self.resolve.record(gpu, encoder, gb, acc, params, &extra, Some((&calls, 3)), target);
         }
         Ok(ShadowPassReport {
             time: std::time::Duration::ZERO,

@@ -396,18 +396,19 @@ pub fn run(map: Option<&Path>, out: &Path, frames: usize, (w, h): (u32, u32)) ->
         let weber = WeberInput { lights: &shade, ambient: Some(&decomposition.ambient_sh), fraction: WEBER_FRACTION };
         let pending = reduction.record(&gpu, &mut encoder, &gbuffer, &shapes, Some(weber))?;
         queue.submit([encoder.finish()]);
-        let stats = pending.read(&gpu)?;
 
-        // every light's visibility recorded into the renderer's encoder, then its shading
-        let receivers = Receivers::from_stats(&gbuffer, &stats, &shapes);
+        // every light's visibility recorded into the renderer's encoder, then its shading: the
+        // reduction stays on the GPU, gates each light's draws and fits the orthographic maps
+        // (no wait for it)
+        let bounds = gpu::conservative_bounds(scene_box(&scene), &gbuffer.camera);
+        let receivers = Receivers::on_gpu(&gbuffer, bounds, pending.on_gpu().clone());
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         visibility.record_clear(&mut encoder);
-        let (map_lights, negligible) = (&shapes[..distant], &stats.negligible[..distant]);
-        gpu::record_visibility(&gpu, &mut encoder, &maps, &receivers, map_lights, negligible, &visibility)?;
-        // the lamp's layer stays lit (cleared) where no visible receiver faces it
-        if receivers.any_faces(&shapes[distant]) {
-            lamp_maps.record(&gpu, &mut encoder, &receivers, &shapes[distant], &visibility.layer(distant as u32))?;
-        }
+        gpu::record_visibility(&gpu, &mut encoder, &maps, &receivers, &shapes[..distant], &[], &visibility)?;
+        // the lamp's layer stays lit (cleared) where the gate finds no visible receiver facing it
+        let lamp = &shapes[distant];
+        let gate = pending.on_gpu().gate(distant as u32);
+        lamp_maps.record(&gpu, &mut encoder, &receivers, lamp, Some(gate), &visibility.layer(distant as u32))?;
         gpu::fullscreen::record(
             &mut encoder,
             &shade_pipeline,
@@ -433,6 +434,15 @@ pub fn run(map: Option<&Path>, out: &Path, frames: usize, (w, h): (u32, u32)) ->
         written.push(path);
     }
     Ok(written)
+}
+
+/// The box around every vertex of `scene`, at the objects' current poses.
+fn scene_box(scene: &scene::Scene) -> (Vec3, Vec3) {
+    scene
+        .objects
+        .iter()
+        .flat_map(|o| &o.mesh.positions)
+        .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
 }
 
 #[cfg(test)]

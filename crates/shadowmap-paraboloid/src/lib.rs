@@ -26,7 +26,7 @@ pub mod paraboloid;
 pub mod subdivide;
 mod technique;
 
-pub use mapper::{DEPTH_FORMAT, LIBRARY, MapParams, ShadowMap, ShadowMapper, ShadowView, VisibilityTarget};
+pub use mapper::{DEPTH_FORMAT, LIBRARY, MapParams, OnGpu, ShadowMap, ShadowMapper, ShadowView, VisibilityTarget};
 pub use technique::MapTechnique;
 
 use glam::Vec3;

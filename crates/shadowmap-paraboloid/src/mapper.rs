@@ -4,7 +4,7 @@
 use crate::paraboloid::{Hemisphere, ParaboloidFrame};
 use crate::{Rejection, ShadowLight, ShadowSettings, Technique};
 use glam::{Mat4, Vec3};
-use gpu::{Chunk, Clock, GBuffer, Gpu, GpuError, ShadowGeometry};
+use gpu::{Calls, Chunk, Clock, GBuffer, Gate, Gpu, GpuError, GpuStats, Indirect, ShadowGeometry};
 use std::time::Duration;
 use wgpu::util::DeviceExt;
 
@@ -72,7 +72,36 @@ pub struct ShadowMap {
     /// The map's first layer in `texture` (0 unless recorded into a shared array,
     /// [`ShadowMapper::record`]).
     pub first_layer: u32,
+    /// An orthographic map fitted to the receivers on the GPU ([`OnGpu::stats`]): its view as
+    /// the GPU made it (`views` holds the CPU's view of the whole scene instead).
+    pub gpu_view: Option<wgpu::Buffer>,
 }
+
+/// What a map's passes take from the GPU instead of the CPU, so that a frame records them
+/// without waiting: the light's gate and the receivers' statistics (an orthographic map's
+/// focus, where its settings give none).
+#[derive(Clone, Copy, Default)]
+pub struct OnGpu<'a> {
+    /// The light's gate: every draw indirect through it.
+    pub gate: Option<Gate<'a>>,
+    /// The receivers' statistics an orthographic map is fitted to.
+    pub stats: Option<&'a GpuStats>,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct FocusParams {
+    s: [f32; 4],
+    u: [f32; 4],
+    f: [f32; 4],
+    d: [f32; 4],
+    scene: [f32; 4],
+    info: [f32; 4],
+    words: [u32; 4],
+}
+
+/// Where `MapParams` holds its first view.
+const FIRST_VIEW_OFFSET: u64 = 5 * 16;
 
 impl ShadowMap {
     /// Triangles drawn over all views.
@@ -153,6 +182,8 @@ pub struct ShadowMapper {
     visibility: wgpu::RenderPipeline,
     // the same pass adding into a `gpu::accumulate::Accumulator` (N-sample maps)
     visibility_add: wgpu::RenderPipeline,
+    // an orthographic view fitted on the GPU (`ortho_focus.wgsl`)
+    focus: wgpu::ComputePipeline,
 }
 
 /// Where a visibility pass writes.
@@ -220,6 +251,7 @@ type Classifier = Box<dyn Fn(&Chunk) -> Class>;
 struct Prepared<'a> {
     map: ShadowMap,
     layer_views: Vec<wgpu::TextureView>,
+    view_buffers: Vec<wgpu::Buffer>,
     binds: Vec<wgpu::BindGroup>,
     /// Each chunk's class per view.
     classes: Vec<Vec<Class>>,
@@ -337,7 +369,22 @@ impl ShadowMapper {
             bind_group_layouts: &[Some(&view_layout)],
             immediate_size: 0,
         });
+        let focus_module = gpu::shader::module(
+            &gpu.device,
+            "orthographic focus",
+            include_str!("../../../shaders/shadowmap-paraboloid/ortho_focus.wgsl"),
+            &[],
+        );
+        let focus = gpu.compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("orthographic focus"),
+            layout: None,
+            module: &focus_module,
+            entry_point: Some("focus"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
         Self {
+            focus,
             paraboloid_clip: gpu
                 .has_clip_distances()
                 .then(|| depth_pipeline(gpu, &layout, "paraboloid clip", src("clip"), false)),
@@ -367,7 +414,8 @@ impl ShadowMapper {
     ) -> Result<ShadowMap, GpuError> {
         let mut p = self.prepare(gpu, geometry, light, technique, settings, None)?;
         let mut drawn = Vec::new();
-        let (time, clock) = gpu.measure(|encoder| drawn = self.record_passes(encoder, geometry, &p))?;
+        let (time, clock) =
+            gpu.measure(|encoder| drawn = self.record_passes(gpu, encoder, geometry, &p, OnGpu::default()))?;
         p.map.time = time;
         p.map.clock = clock;
         Ok(p.finish(drawn))
@@ -378,6 +426,9 @@ impl ShadowMapper {
     /// (the caller times the submission). `target`: layers `first..` of a `DEPTH_FORMAT` array of
     /// `settings.resolution`² layers (e.g. one for all of a frame's maps, so that one pass can
     /// read them all), or `None` for a texture of its own.
+    ///
+    /// `on_gpu`: the light's gate and the receivers' statistics where the frame takes them
+    /// from the GPU ([`OnGpu`]; its default for neither).
     ///
     /// # Errors
     /// As [`ShadowMapper::render`]; a target of another format or size, or without the layers.
@@ -391,10 +442,79 @@ impl ShadowMapper {
         technique: Technique,
         settings: &ShadowSettings,
         target: Option<(&wgpu::Texture, u32)>,
+        on_gpu: OnGpu<'_>,
     ) -> Result<ShadowMap, GpuError> {
-        let p = self.prepare(gpu, geometry, light, technique, settings, target)?;
-        let drawn = self.record_passes(encoder, geometry, &p);
+        let mut p = self.prepare(gpu, geometry, light, technique, settings, target)?;
+        let fit = match (technique, light, on_gpu.stats) {
+            (Technique::Orthographic, ShadowLight::Distant { direction }, Some(stats)) if settings.focus.is_none() => {
+                Some(self.record_focus(gpu, encoder, geometry, *direction, settings.resolution, stats))
+            }
+            _ => None,
+        };
+        if let (Some(fit), Some(view)) = (&fit, p.view_buffers.first()) {
+            encoder.copy_buffer_to_buffer(fit, 0, view, 0, std::mem::size_of::<ViewUniform>() as u64);
+        }
+        p.map.gpu_view = fit;
+        let drawn = self.record_passes(gpu, encoder, geometry, &p, on_gpu);
         Ok(p.finish(drawn))
+    }
+
+    /// Records the orthographic view of a map towards `direction` fitted to the receivers'
+    /// statistics on the GPU (`ortho_focus.wgsl`: the CPU's arithmetic in `prepare`).
+    fn record_focus(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        geometry: &ShadowGeometry,
+        direction: Vec3,
+        resolution: u32,
+        stats: &GpuStats,
+    ) -> wgpu::Buffer {
+        let (center, radius) = bounds(geometry);
+        let d = direction.normalize_or(Vec3::Y);
+        let up = if d.y.abs() < 0.9 { Vec3::Y } else { Vec3::X };
+        // `look_to_mat4(eye, -d, up)`'s axes, which do not depend on the eye
+        let f = -d;
+        let s = f.cross(up).normalize();
+        let u = s.cross(f);
+        let params = FocusParams {
+            s: s.extend(0.0).to_array(),
+            u: u.extend(0.0).to_array(),
+            f: f.extend(0.0).to_array(),
+            d: d.extend(0.0).to_array(),
+            scene: center.extend(radius).to_array(),
+            info: [resolution as f32, 0.0, 0.0, 0.0],
+            words: [GpuStats::COUNT_WORD, GpuStats::MEAN_WORD, GpuStats::RADIUS_WORD, 0],
+        };
+        let params = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("orthographic focus"),
+            contents: bytemuck::bytes_of(&params),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let view = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("orthographic view"),
+            size: std::mem::size_of::<ViewUniform>() as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("orthographic focus"),
+            layout: &self.focus.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: stats.buffer().as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: view.as_entire_binding() },
+            ],
+        });
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("orthographic focus"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.focus);
+        pass.set_bind_group(0, &bind, &[]);
+        pass.dispatch_workgroups(1, 1, 1);
+        drop(pass);
+        view
     }
 
     /// The views (texture layers) a map of `light` by `technique` has: a hemispherical
@@ -536,14 +656,19 @@ impl ShadowMapper {
         };
         let layer_views: Vec<wgpu::TextureView> =
             (0..layers).map(|l| gpu::layer_view(&texture, first_layer + l)).collect();
-        let binds: Vec<wgpu::BindGroup> = views
+        let view_buffers: Vec<wgpu::Buffer> = views
             .iter()
             .map(|(v, _)| {
-                let buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some("shadow view"),
                     contents: bytemuck::bytes_of(&v.uniform()),
-                    usage: wgpu::BufferUsages::UNIFORM,
-                });
+                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                })
+            })
+            .collect();
+        let binds: Vec<wgpu::BindGroup> = view_buffers
+            .iter()
+            .map(|buffer| {
                 gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("shadow view"),
                     layout: &self.view_layout,
@@ -565,14 +690,35 @@ impl ShadowMapper {
             time: std::time::Duration::ZERO,
             clock: gpu::Clock::WallTime,
             first_layer,
+            gpu_view: None,
         };
-        Ok(Prepared { map, layer_views, binds, classes, inside, straddle })
+        Ok(Prepared { map, layer_views, view_buffers, binds, classes, inside, straddle })
     }
 
-    /// Records a prepared map's depth passes; the triangles drawn per view.
-    fn record_passes(&self, encoder: &mut wgpu::CommandEncoder, geometry: &ShadowGeometry, p: &Prepared) -> Vec<u32> {
+    /// Records a prepared map's depth passes (gated by `on_gpu.gate`); the triangles drawn
+    /// per view.
+    fn record_passes(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        geometry: &ShadowGeometry,
+        p: &Prepared,
+        on_gpu: OnGpu<'_>,
+    ) -> Vec<u32> {
+        // per view, the runs of chunks inside it, then those across its edge
         let mut drawn = vec![0; p.classes.len()];
-        for (k, (class, bind)) in p.classes.iter().zip(&p.binds).enumerate() {
+        let mut runs = Vec::with_capacity(p.classes.len());
+        let mut args = Vec::new();
+        for (k, class) in p.classes.iter().enumerate() {
+            let (inside, a) = geometry.runs(|c| class[c] == Class::Inside);
+            let (straddle, b) = geometry.runs(|c| class[c] == Class::Straddle);
+            drawn[k] = a + b;
+            runs.push((inside.len(), straddle.len()));
+            args.extend(inside.into_iter().chain(straddle).map(Indirect::draw));
+        }
+        let calls = Calls::new(gpu, encoder, on_gpu.gate, args);
+        let mut call = 0;
+        for (k, bind) in p.binds.iter().enumerate() {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("shadow depth"),
                 color_attachments: &[],
@@ -584,10 +730,18 @@ impl ShadowMapper {
                 ..Default::default()
             });
             pass.set_bind_group(0, bind, &[]);
+            geometry.set_vertices(&mut pass);
+            let (inside, straddle) = runs[k];
             pass.set_pipeline(p.inside);
-            drawn[k] = geometry.draw(&mut pass, |c| class[c] == Class::Inside);
+            for _ in 0..inside {
+                calls.draw(&mut pass, call);
+                call += 1;
+            }
             pass.set_pipeline(p.straddle);
-            drawn[k] += geometry.draw(&mut pass, |c| class[c] == Class::Straddle);
+            for _ in 0..straddle {
+                calls.draw(&mut pass, call);
+                call += 1;
+            }
         }
         drawn
     }
@@ -605,13 +759,14 @@ impl ShadowMapper {
         target: &wgpu::TextureView,
     ) -> Result<(), GpuError> {
         let mut encoder = gpu.encoder("shadow visibility");
-        self.record_visibility(gpu, &mut encoder, map, gbuffer, VisibilityTarget::Layer(target), 0.0);
+        self.record_visibility(gpu, &mut encoder, map, gbuffer, VisibilityTarget::Layer(target), 0.0, None);
         gpu.submit_and_wait(encoder)
     }
 
     /// Records `map`'s visibility pass into `encoder`, writing a visibility layer or adding into
     /// an accumulator (cleared first when asked). `half_angle` is the light's (radians), used by
-    /// PCSS (`settings.pcss`) on orthographic maps.
+    /// PCSS (`settings.pcss`) on orthographic maps; `gate`: the light's, when the frame gates it.
+    #[allow(clippy::too_many_arguments)]
     pub fn record_visibility(
         &self,
         gpu: &Gpu,
@@ -620,14 +775,20 @@ impl ShadowMapper {
         gbuffer: &GBuffer,
         target: VisibilityTarget<'_>,
         half_angle: f32,
+        gate: Option<Gate<'_>>,
     ) {
         // the view below starts at the map's first layer
         let params = map.lookup_params(half_angle, 0);
         let buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("visibility params"),
             contents: bytemuck::bytes_of(&params),
-            usage: wgpu::BufferUsages::UNIFORM,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
+        if let Some(view) = &map.gpu_view {
+            let size = std::mem::size_of::<ViewUniform>() as u64;
+            encoder.copy_buffer_to_buffer(view, 0, &buffer, FIRST_VIEW_OFFSET, size);
+        }
+        let calls = Calls::new(gpu, encoder, gate, vec![Indirect::draw(0..3)]);
         let position = gbuffer.position.create_view(&Default::default());
         let normal = gbuffer.geometric_normal.create_view(&Default::default());
         let shadow = map.texture.create_view(&wgpu::TextureViewDescriptor {
@@ -667,6 +828,6 @@ impl ShadowMapper {
         });
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &bind, &[]);
-        pass.draw(0..3, 0..1);
+        calls.draw(&mut pass, 0);
     }
 }

@@ -2,7 +2,7 @@
 //! PCSS on it, or the mean of N hard maps from directions spread over the light (Heckbert and
 //! Herf 1997, paper 000's reference method).
 
-use crate::mapper::{ShadowMapper, VisibilityTarget};
+use crate::mapper::{OnGpu, ShadowMapper, VisibilityTarget};
 use crate::{ShadowLight, ShadowSettings, Technique, shadow_triangles};
 use glam::Vec3;
 use gpu::accumulate::{Accumulator, ResolvePass};
@@ -176,6 +176,7 @@ impl ShadowTechnique for MapTechnique {
         encoder: &mut wgpu::CommandEncoder,
         receivers: &Receivers,
         light: &LightShape,
+        gate: Option<gpu::Gate<'_>>,
         target: &wgpu::TextureView,
     ) -> Result<ShadowPassReport, GpuError> {
         if !self.supports(light) {
@@ -208,18 +209,21 @@ impl ShadowTechnique for MapTechnique {
         let scratch = self.scratch(gpu, size, (settings.resolution, layers), lights.len() > 1)?;
         for (k, l) in lights.iter().enumerate() {
             // one map texture for all of them: the passes run in the order recorded
-            let map =
-                shared.mapper.record(gpu, encoder, geometry, l, self.technique, &settings, Some((&scratch.map, 0)))?;
+            let on_gpu = OnGpu { gate, stats: receivers.on_gpu.as_ref() };
+            let into = Some((&scratch.map, 0));
+            let map = shared.mapper.record(gpu, encoder, geometry, l, self.technique, &settings, into, on_gpu)?;
             primitives += u64::from(map.triangles_drawn());
             let out = match &scratch.accumulator {
                 Some(a) => VisibilityTarget::Add(a, k == 0),
                 None => VisibilityTarget::Layer(target),
             };
-            shared.mapper.record_visibility(gpu, encoder, &map, receivers.gbuffer, out, half_angle);
+            shared.mapper.record_visibility(gpu, encoder, &map, receivers.gbuffer, out, half_angle, gate);
         }
         if let Some(a) = &scratch.accumulator {
             let scale = [1.0 / lights.len() as f32, 0.0, 0.0, 0.0];
-            shared.resolve.record(gpu, encoder, receivers.gbuffer, a, bytemuck::cast_slice(&scale), &[], target);
+            let calls = gpu::Calls::new(gpu, encoder, gate, vec![gpu::Indirect::draw(0..3)]);
+            let params = bytemuck::cast_slice(&scale);
+            shared.resolve.record(gpu, encoder, receivers.gbuffer, a, params, &[], Some((&calls, 0)), target);
         }
         Ok(ShadowPassReport { time: Duration::ZERO, clock: None, skipped: None, primitives, culled: Vec::new() })
     }

@@ -39,16 +39,9 @@ fn recorded(
     receivers: &Receivers,
     lights: &[LightShape],
 ) -> (Vec<Vec<f32>>, gpu::GpuCounters) {
-    let (w, h) = receivers.gbuffer.size();
-    let vis = Visibility::allocate(gpu, w, h, lights.len() as u32).unwrap();
-    let mut encoder = gpu.encoder("all lights");
-    let before = gpu.counters();
-    vis.record_clear(&mut encoder);
-    let reports = record_visibility(gpu, &mut encoder, t, receivers, lights, &[], &vis).unwrap();
-    let during = gpu.counters() - before;
+    let (layers, during, reports) = recorded_any(gpu, t, receivers, lights);
     assert!(reports.iter().all(|r| r.skipped.is_none() && r.primitives > 0));
-    gpu.submit(encoder);
-    ((0..lights.len() as u32).map(|k| vis.read(gpu, k).unwrap()).collect(), during)
+    (layers, during)
 }
 
 fn waited(gpu: &Gpu, t: &MapTechnique, receivers: &Receivers, lights: &[LightShape]) -> Vec<Vec<f32>> {
@@ -122,4 +115,64 @@ fn a_moved_object_shadows_as_maps_built_for_its_pose() {
     other.objects[object].mesh.indices.pop();
     assert!(updated.update_object(&gpu, &other, object).is_err());
     assert!(updated.update_object(&gpu, &moved, moved.objects.len()).is_err());
+}
+
+#[test]
+fn maps_fitted_and_gated_on_the_gpu_equal_maps_fitted_on_the_cpu() {
+    // the same reduction read back (`from_stats`: the CPU fits the orthographic maps, and skips)
+    // and left on the GPU (`on_gpu`: `ortho_focus.wgsl` fits them, the gate skips): the
+    // arithmetic is the CPU's operation for operation
+    let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
+    let scene = scene();
+    let geometry = SceneGeometry::upload(&gpu, &scene).unwrap();
+    let gb = GBufferPass::new(&gpu).render(&gpu, &geometry, &scene.camera).unwrap();
+    let reduction = gpu::ReceiverReduction::new(&gpu);
+    let mut lights = distant();
+    // nothing the camera sees faces a light from below: skipped either way
+    lights.push(LightShape::Distant { direction: Vec3::NEG_Y, half_angle: 1e-4 });
+    let all: Vec<LightShape> = lights.iter().chain(&local()).copied().collect();
+    let mut encoder = gpu.encoder("reduction");
+    let pending = reduction.record(&gpu, &mut encoder, &gb, &all, None).unwrap();
+    gpu.submit(encoder);
+    let on_gpu = pending.on_gpu().clone();
+    let stats = pending.read(&gpu).unwrap();
+    let read = Receivers::from_stats(&gb, &stats, &all);
+    let left = Receivers::on_gpu(&gb, read.bounds, on_gpu.clone());
+    let local_left = Receivers::on_gpu(&gb, read.bounds, on_gpu.starting_at(lights.len() as u32));
+    let ortho = MapTechnique::new(&gpu, &scene, Technique::Orthographic, settings(), 1).unwrap();
+    let cases = [
+        (ortho.variant(Technique::Orthographic, settings(), 1), &lights[..], &left),
+        (ortho.variant(Technique::Orthographic, settings(), 4), &lights[..], &left),
+        (ortho.variant(Technique::Cube, settings(), 1), &all[lights.len()..], &local_left),
+        (ortho.variant(Technique::DualParaboloid, settings(), 1), &all[lights.len()..], &local_left),
+    ];
+    for (technique, lights, left) in cases {
+        let name = gpu::ShadowTechnique::name(&technique);
+        let (want, _, reports) = recorded_any(&gpu, &technique, &read, lights);
+        let (got, during, _) = recorded_any(&gpu, &technique, left, lights);
+        assert_eq!((during.submits, during.waits, during.readback_bytes), (0, 0, 0), "{name}");
+        for (k, (a, b)) in want.iter().zip(&got).enumerate() {
+            let differ = a.iter().zip(b).filter(|(x, y)| x != y).count();
+            assert_eq!(differ, 0, "{name}, light {k} (skipped on the CPU: {:?})", reports[k].skipped);
+        }
+    }
+}
+
+/// Per light its layer, every light recorded into one encoder (some may be skipped); the
+/// counters while recording; the reports.
+fn recorded_any(
+    gpu: &Gpu,
+    t: &MapTechnique,
+    receivers: &Receivers,
+    lights: &[LightShape],
+) -> (Vec<Vec<f32>>, gpu::GpuCounters, Vec<gpu::ShadowPassReport>) {
+    let (w, h) = receivers.gbuffer.size();
+    let vis = Visibility::allocate(gpu, w, h, lights.len() as u32).unwrap();
+    let mut encoder = gpu.encoder("all lights");
+    let before = gpu.counters();
+    vis.record_clear(&mut encoder);
+    let reports = record_visibility(gpu, &mut encoder, t, receivers, lights, &[], &vis).unwrap();
+    let during = gpu.counters() - before;
+    gpu.submit(encoder);
+    ((0..lights.len() as u32).map(|k| vis.read(gpu, k).unwrap()).collect(), during, reports)
 }

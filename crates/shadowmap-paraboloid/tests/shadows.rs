@@ -10,7 +10,7 @@ use scene::{Material, Mesh, Object, Scene};
 use shadowmap_paraboloid::cpu::{CpuParaboloidMap, lit};
 use shadowmap_paraboloid::paraboloid::Hemisphere;
 use shadowmap_paraboloid::{
-    Rejection, ShadowLight, ShadowMap, ShadowMapper, ShadowSettings, Technique, disagreement, shadow_triangles,
+    OnGpu, Rejection, ShadowLight, ShadowMap, ShadowMapper, ShadowSettings, Technique, disagreement, shadow_triangles,
 };
 
 fn gpu() -> Gpu {
@@ -333,14 +333,24 @@ fn maps_recorded_into_one_submission_equal_maps_rendered_one_by_one() {
     let mut batched: Vec<ShadowMap> = Vec::new();
     for (k, (l, t)) in lights.iter().enumerate() {
         let target = (k < 2).then(|| (&shared, 1 + batched.iter().map(|m| m.views.len() as u32).sum::<u32>()));
-        batched.push(s.mapper.record(&s.gpu, &mut encoder, &geometry, l, *t, &settings, target).unwrap());
+        batched.push(
+            s.mapper.record(&s.gpu, &mut encoder, &geometry, l, *t, &settings, target, OnGpu::default()).unwrap(),
+        );
     }
     s.gpu.submit_and_wait(encoder).unwrap();
     assert_eq!((batched[0].first_layer, batched[1].first_layer), (1, 3));
     // a target without room for the map is refused, not overrun
     let mut encoder = s.gpu.encoder("too small");
-    let e =
-        s.mapper.record(&s.gpu, &mut encoder, &geometry, &lights[2].0, Technique::Cube, &settings, Some((&shared, 0)));
+    let e = s.mapper.record(
+        &s.gpu,
+        &mut encoder,
+        &geometry,
+        &lights[2].0,
+        Technique::Cube,
+        &settings,
+        Some((&shared, 0)),
+        OnGpu::default(),
+    );
     assert!(e.is_err(), "six cube faces in a four-layer array");
     for ((l, t), b) in lights.iter().zip(&batched) {
         let alone = s.mapper.render(&s.gpu, &geometry, l, *t, &settings).unwrap();
