@@ -344,8 +344,11 @@ pub fn record_visibility(
     })
 }
 
-/// As [`record_visibility`], each light in a submission of its own, waited for and timed
-/// ([`ShadowTechnique::write_visibility`]): per-light GPU times for validate and the trade.
+/// [`record_visibility`] measured: every light's passes recorded into one encoder between two
+/// GPU timestamps of its own, one submission, one wait; each report's `time` is its light's.
+/// Without timestamps inside encoders each light goes in a submission of its own, waited for
+/// and timed on the wall clock ([`ShadowTechnique::write_visibility`]). What validate, the trade
+/// and the benches measure a frame's lights with.
 ///
 /// # Errors
 /// As [`record_visibility`]; GPU failures.
@@ -357,9 +360,62 @@ pub fn render_visibility(
     negligible: &[bool],
     visibility: &Visibility,
 ) -> Result<Vec<ShadowPassReport>, GpuError> {
-    each_light(receivers, lights, negligible, visibility, |k, light| {
-        technique.write_visibility(gpu, receivers, light, &visibility.layer(k))
-    })
+    let timestamps = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+    if !gpu.features.contains(timestamps) || lights.is_empty() {
+        return each_light(receivers, lights, negligible, visibility, |k, light| {
+            technique.write_visibility(gpu, receivers, light, &visibility.layer(k))
+        });
+    }
+    let queries = 2 * lights.len() as u32;
+    if queries > wgpu::QUERY_SET_MAX_QUERIES {
+        return Err(GpuError::TooLarge {
+            what: "lights timed in one submission",
+            size: lights.len() as u64,
+            limit: u64::from(wgpu::QUERY_SET_MAX_QUERIES / 2),
+        });
+    }
+    let set = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
+        label: Some("per-light timestamps"),
+        ty: wgpu::QueryType::Timestamp,
+        count: queries,
+    });
+    let bytes = 8 * u64::from(queries);
+    let buffer = |label, usage| {
+        gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: bytes,
+            usage,
+            mapped_at_creation: false,
+        })
+    };
+    let resolve = buffer("per-light timestamps", wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC);
+    let read = buffer("per-light timestamps read", wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
+    let mut encoder = gpu.encoder("lights, each timed");
+    let mut timed = Vec::with_capacity(lights.len());
+    let mut reports = each_light(receivers, lights, negligible, visibility, |k, light| {
+        encoder.write_timestamp(&set, 2 * k);
+        let gate = receivers.on_gpu.as_ref().map(|s| s.gate(k));
+        let report = technique.record(gpu, &mut encoder, receivers, light, gate, &visibility.layer(k));
+        encoder.write_timestamp(&set, 2 * k + 1);
+        timed.push(k as usize);
+        report
+    })?;
+    // skipped lights' slots are written too (nothing between them), so that every query resolves
+    for k in (0..lights.len()).filter(|k| !timed.contains(k)) {
+        encoder.write_timestamp(&set, 2 * k as u32);
+        encoder.write_timestamp(&set, 2 * k as u32 + 1);
+    }
+    encoder.resolve_query_set(&set, 0..queries, &resolve, 0);
+    encoder.copy_buffer_to_buffer(&resolve, 0, &read, 0, bytes);
+    gpu.submit_and_wait(encoder)?;
+    let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&crate::readback::read_mapped(gpu, &read)?);
+    let period = f64::from(gpu.queue.get_timestamp_period());
+    for k in timed {
+        let ns = ticks[2 * k + 1].saturating_sub(ticks[2 * k]) as f64 * period;
+        reports[k].time = Duration::from_nanos(ns as u64);
+        reports[k].clock = Some(Clock::GpuTimestamps);
+    }
+    Ok(reports)
 }
 
 /// Weber's fraction: a change of luminance below 2 % of what a surface already receives is not

@@ -87,3 +87,36 @@ fn gated_lights_draw_exactly_where_the_reduction_says_they_need_a_pass() {
     // each case happens: drawn, faced by nothing visible, under Weber's 2 %
     assert!(drawn > 0 && unfaced > 0 && negligible > 0, "{drawn} drawn, {unfaced} unfaced, {negligible} negligible");
 }
+
+#[test]
+fn measured_lights_share_one_submission_each_with_its_own_time() {
+    // `render_visibility` wraps the recorded loop: with timestamps inside encoders, one
+    // submission for every light, each timed between two timestamps of its own
+    let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
+    let mut scene = scene::Scene::builtin("spheres_box").unwrap();
+    (scene.camera.width, scene.camera.height) = (32, 24);
+    let geometry = SceneGeometry::upload(&gpu, &scene).unwrap();
+    let gb = GBufferPass::new(&gpu).render(&gpu, &geometry, &scene.camera).unwrap();
+    let points = gb.read_points(&gpu).unwrap();
+    let receivers = Receivers::new(&gb, &points);
+    let shapes: Vec<LightShape> = lights().iter().map(shape).take(3).collect();
+    let layers = shapes.iter().map(|l| (*l, vec![0.5; 32 * 24])).collect();
+    let technique = PrecomputedVisibility::new(&gpu, "half", (32, 24), layers).unwrap();
+    let vis = Visibility::allocate(&gpu, 32, 24, shapes.len() as u32).unwrap();
+    let before = gpu.counters();
+    let reports = gpu::render_visibility(&gpu, &technique, &receivers, &shapes, &[], &vis).unwrap();
+    let d = gpu.counters() - before;
+    let timestamps = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+    let drawn = reports.iter().filter(|r| r.skipped.is_none()).count() as u64;
+    assert!(drawn > 0);
+    if gpu.features.contains(timestamps) {
+        assert_eq!(d.submits, 1, "{d:?}");
+        assert!(reports.iter().filter(|r| r.skipped.is_none()).all(|r| r.clock == Some(gpu::Clock::GpuTimestamps)));
+    } else {
+        assert_eq!(d.submits, drawn, "{d:?}");
+    }
+    for (k, r) in reports.iter().enumerate() {
+        let want = if r.skipped.is_some() { 1.0 } else { 128.0 / 255.0 };
+        assert!(vis.read(&gpu, k as u32).unwrap().iter().all(|v| (v - want).abs() < 1e-6), "light {k}");
+    }
+}
