@@ -100,6 +100,8 @@ pub struct Frame {
     maps: MapTechnique,
     // the receivers of the full- and the low-resolution G-buffer
     reductions: [ReceiverReduction; 2],
+    // the box around every vertex at the current poses, made when an object moves, not per frame
+    scene_box: Option<(glam::Vec3, glam::Vec3)>,
 }
 
 impl Frame {
@@ -133,6 +135,7 @@ impl Frame {
             wedges: Wedges::new(gpu, &scene, WedgeSettings::default()),
             maps: MapTechnique::new(gpu, &scene, Technique::Orthographic, maps_settings(), 1).map_err(e)?,
             reductions: [ReceiverReduction::new(gpu), ReceiverReduction::new(gpu)],
+            scene_box: scene_bounds(&scene),
             rest: scene.clone(),
             scene,
             decomposition,
@@ -149,6 +152,7 @@ impl Frame {
         let rest = self.rest.objects.get(object).ok_or_else(|| GpuError::Failed(format!("no object {object}")))?;
         let moved = rest.mesh.positions.iter().map(|p| *p + offset).collect();
         self.scene.objects[object].mesh.positions = moved;
+        self.scene_box = scene_bounds(&self.scene);
         self.geometry.update_object(gpu, &self.scene, object)?;
         self.wedges.update_object(&self.scene, object)?;
         self.maps.update_object(gpu, &self.scene, object)
@@ -187,7 +191,7 @@ impl Frame {
         let settings = SplitSettings { indirect_scale: scale, upsample: JointBilateral::PAPER };
         let low_camera = indirect_camera(&self.scene.camera, &settings)?;
         let (gb, low_gb, pending) = self.submit_reduced(gpu, &lights, &shapes, &low_camera, scale)?;
-        let scene_box = scene_bounds(&self.scene);
+        let scene_box = self.scene_box;
         let directs = d.directs() as u32;
         let bounds = scene_box.and_then(|b| gpu::conservative_bounds(b, &self.scene.camera));
         let receivers = Receivers::on_gpu(&gb, bounds, pending[0].on_gpu().clone());
