@@ -193,11 +193,11 @@ impl Frame {
         let (gb, low_gb, pending) = self.submit_reduced(gpu, &lights, &shapes, &low_camera, scale)?;
         let scene_box = self.scene_box;
         let directs = d.directs() as u32;
-        let bounds = scene_box.and_then(|b| gpu::conservative_bounds(b, &self.scene.camera));
+        let bounds = scene_box.and_then(|b| gpu::conservative_bounds(b, &gb.view));
         let receivers = Receivers::on_gpu(&gb, bounds, pending[0].on_gpu().clone());
         let low_gpu = pending[pending.len() - 1].on_gpu().starting_at(directs);
         let low = match &low_gb {
-            Some(l) => Receivers::on_gpu(l, scene_box.and_then(|b| gpu::conservative_bounds(b, &low_camera)), low_gpu),
+            Some(l) => Receivers::on_gpu(l, scene_box.and_then(|b| gpu::conservative_bounds(b, &l.view)), low_gpu),
             None => Receivers::on_gpu(&gb, bounds, low_gpu),
         };
         let mut encoder = gpu.encoder("frame");

@@ -43,7 +43,8 @@ struct GBufferOut {
 
 fn surface(world: vec3<f32>, normal: vec3<f32>, geometric_normal: vec3<f32>, object: u32) -> GBufferOut {
     var ng = geometric_normal;
-    if dot(ng, camera.eye.xyz - world) < 0.0 {
+    // toward the viewer: to the eye, or (w = 0) along an orthographic view's axis
+    if dot(ng, camera.eye.xyz - world * camera.eye.w) < 0.0 {
         ng = -ng;
     }
     var ns = normal;

@@ -180,7 +180,8 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let m = materials[u32(p.w)];
     let n = textureLoad(g_normal, pixel, 0).xyz;
     let ng = textureLoad(g_geometric_normal, pixel, 0).xyz;
-    let wo = normalize(params.eye.xyz - p.xyz);
+    // toward the viewer: to the eye, or (w = 0) along an orthographic view's axis
+    let wo = normalize(params.eye.xyz - p.xyz * params.eye.w);
     var l = vec3<f32>(0.0);
     for (var k = 0u; k < params.counts.x; k++) {
         let light = lights[k];

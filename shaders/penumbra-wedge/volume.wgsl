@@ -6,7 +6,12 @@
 
 struct View {
     view_proj: mat4x4<f32>,
+    // w = 1: the eye of a perspective; w = 0: a point behind every receiver of an
+    // orthographic view, depths measured from it along `forward`
     eye: vec4<f32>,
+    // an orthographic view's axis (w unused). A mirrored (left-handed) view flips which
+    // faces are front faces: the counts change sign, which the resolve's |count| ignores.
+    forward: vec4<f32>,
 }
 
 @group(0) @binding(0) var<uniform> view: View;
@@ -25,6 +30,14 @@ fn vs(@location(0) position: vec3<f32>) -> VsOut {
     return out;
 }
 
+// how far along its view ray `x` lies
+fn depth(x: vec3<f32>) -> f32 {
+    if view.eye.w > 0.5 {
+        return distance(x, view.eye.xyz);
+    }
+    return dot(x - view.eye.xyz, view.forward.xyz);
+}
+
 @fragment
 fn fs(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
     let g = textureLoad(g_position, vec2<i32>(in.clip.xy), 0);
@@ -34,8 +47,8 @@ fn fs(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
     // depth fail: the face lies at or behind the surface. The front cap lies on the casters'
     // lit faces; where the surface is such a face its cap fragment must count (as a depth test
     // LESS fails on equal depths), so a relative margin lets faces a hair in front count too.
-    let t_surface = distance(g.xyz, view.eye.xyz);
-    if distance(in.world, view.eye.xyz) < t_surface * (1.0 - 1e-5) {
+    let t_surface = depth(g.xyz);
+    if depth(in.world) < t_surface * (1.0 - 1e-5) {
         discard;
     }
     return vec4<f32>(select(1.0, -1.0, front), 0.0, 0.0, 0.0);

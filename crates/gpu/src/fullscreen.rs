@@ -23,6 +23,17 @@ pub fn pipeline_with_target(
     module: &wgpu::ShaderModule,
     target: wgpu::ColorTargetState,
 ) -> wgpu::RenderPipeline {
+    pipeline_with_targets(gpu, label, module, &[Some(target)])
+}
+
+/// As [`pipeline_with_target`] writing several targets (`@location(k)` to `targets[k]`).
+#[must_use]
+pub fn pipeline_with_targets(
+    gpu: &Gpu,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    targets: &[Option<wgpu::ColorTargetState>],
+) -> wgpu::RenderPipeline {
     gpu.render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
         layout: None,
@@ -39,7 +50,7 @@ pub fn pipeline_with_target(
             module,
             entry_point: Some("fs"),
             compilation_options: Default::default(),
-            targets: &[Some(target)],
+            targets,
         }),
         multiview_mask: None,
         cache: None,

@@ -19,8 +19,8 @@ pub struct GBuffer {
     pub geometric_normal: wgpu::Texture,
     /// Depth (Depth32Float).
     pub depth: wgpu::Texture,
-    /// The camera it was rendered with.
-    pub camera: scene::Camera,
+    /// The view it was rendered from: what techniques know of the camera.
+    pub view: crate::View,
 }
 
 /// Projection × view of `camera` for wgpu's clip space (depth in [0, 1]); `near`/`far` in metres.
@@ -31,7 +31,7 @@ pub fn view_projection(camera: &scene::Camera, near: f32, far: f32) -> Mat4 {
 }
 
 /// (vertical field of view, aspect ratio, view matrix) of `camera`.
-fn view_and_fov(camera: &scene::Camera) -> (f32, f32, Mat4) {
+pub(crate) fn view_and_fov(camera: &scene::Camera) -> (f32, f32, Mat4) {
     let aspect = camera.width as f32 / camera.height as f32;
     let tan_half_x = (camera.hfov_degrees.to_radians() * 0.5).tan();
     let (_, up, forward) = camera.basis();
@@ -161,6 +161,9 @@ impl GBufferPass {
 
     /// Records the G-buffer pass of `geometry` seen by `camera` into `encoder`, without
     /// submitting: the returned targets hold the G-buffer once the caller's submission runs.
+    /// The camera's view is projected with an infinite reversed depth whose near plane scales
+    /// with the scene's reach from the eye: no absolute distance, so a scene scaled by 1e-3 or
+    /// 1e3 rasterizes the same.
     ///
     /// # Errors
     /// [`GpuError::TooLarge`] for an image beyond the adapter's limits.
@@ -171,23 +174,37 @@ impl GBufferPass {
         geometry: &SceneGeometry,
         camera: &scene::Camera,
     ) -> Result<GBuffer, GpuError> {
-        let size = (camera.width, camera.height, 1);
+        let (lo, hi) = geometry.bounds;
+        let reach = if lo.is_finite() { (hi - lo).length() + camera.eye.distance(0.5 * (lo + hi)) } else { 1.0 };
+        let near = (reach * 1e-6).max(f32::MIN_POSITIVE * 1e6);
+        self.record_view(gpu, encoder, geometry, &crate::View::from_camera(camera, near))
+    }
+
+    /// Records the G-buffer pass of `geometry` seen from `view` (any projection in wgpu's clip
+    /// space whose nearer depths are larger, as reversed depth has them) into `encoder`.
+    ///
+    /// # Errors
+    /// [`GpuError::TooLarge`] for an image beyond the adapter's limits.
+    pub fn record_view(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        geometry: &SceneGeometry,
+        view: &crate::View,
+    ) -> Result<GBuffer, GpuError> {
+        let (w, h) = view.size();
+        let size = (w, h, 1);
         let target = |label, format| crate::target::render_target(gpu, label, size, format);
         let gb = GBuffer {
             position: target("gbuffer position", GBUFFER_FORMAT)?,
             normal: target("gbuffer normal", GBUFFER_FORMAT)?,
             geometric_normal: target("gbuffer geometric normal", GBUFFER_FORMAT)?,
             depth: target("gbuffer depth", wgpu::TextureFormat::Depth32Float)?,
-            camera: *camera,
+            view: *view,
         };
-        // The near plane scales with the scene's reach from the eye: no absolute distance, so a
-        // scene scaled by 1e-3 or 1e3 rasterizes the same.
-        let (lo, hi) = geometry.bounds;
-        let reach = if lo.is_finite() { (hi - lo).length() + camera.eye.distance(0.5 * (lo + hi)) } else { 1.0 };
-        let near = (reach * 1e-6).max(f32::MIN_POSITIVE * 1e6);
         let uniform = CameraUniform {
-            view_proj: view_projection_reverse(camera, near).to_cols_array_2d(),
-            eye: Vec3::extend(camera.eye, 1.0).to_array(),
+            view_proj: view.view_projection().to_cols_array_2d(),
+            eye: view.toward_viewer().to_array(),
         };
         let buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("camera"),
@@ -249,7 +266,7 @@ impl GBuffer {
     /// Image size.
     #[must_use]
     pub fn size(&self) -> (u32, u32) {
-        (self.camera.width, self.camera.height)
+        self.view.size()
     }
 
     /// Reads the positions back: xyz and object index (-1 for background), row-major.

@@ -14,6 +14,7 @@
 pub mod accumulate;
 pub mod ambient;
 mod context;
+mod from_depth;
 pub mod fullscreen;
 mod gate;
 mod gbuffer;
@@ -29,9 +30,11 @@ mod target;
 mod technique;
 mod timer;
 mod upsample;
+mod view;
 
 pub use ambient::{DfgTable, PrefilterSettings, PrefilteredMap, SpecularAmbient};
 pub use context::{ADAPTER_ENV, Gpu, GpuCounters, GpuError, adapters, describe_adapter, pick_adapter};
+pub use from_depth::DepthGBufferPass;
 pub use gate::{Calls, Gate, GatedArgs, GpuStats, Indirect};
 pub use gbuffer::{
     GBUFFER_FORMAT, GBuffer, GBufferPass, PointsRead, view_projection, view_projection_infinite,
@@ -49,8 +52,8 @@ pub use supersample::RotatedGrid;
 pub use target::{layer_view, render_target};
 pub use technique::{
     LightShape, PrecomputedVisibility, Receivers, ShadowPassReport, ShadowTechnique, WEBER_FRACTION,
-    WEBER_MAX_RECEIVERS, conservative_bounds, culled_totals, record_visibility, render_visibility, skip_reasons,
-    totals, weber_negligible,
+    WEBER_MAX_RECEIVERS, culled_totals, record_visibility, render_visibility, skip_reasons, totals, weber_negligible,
 };
 pub use timer::Clock;
 pub use upsample::{JointBilateral, UpsamplePass};
+pub use view::{View, conservative_bounds};

@@ -247,13 +247,13 @@ impl ShadingPass {
             });
         }
         let output = crate::target::render_target(gpu, "shaded", (w, h, 1), HDR_FORMAT)?;
-        let rays = gbuffer.camera.rays();
+        let rays = gbuffer.view.rays();
         let sh =
             params.ambient.map_or([[0.0f32; 4]; 9], |a| a.irradiance_coefficients().map(|c| c.extend(0.0).to_array()));
         let (bw, bh) = params.background.map_or((0, 0), |b| b.size);
         let background = &params.background.unwrap_or(&self.no_background).texture;
         let uniform = ShadeUniform {
-            eye: rays.eye.extend(1.0).to_array(),
+            eye: gbuffer.view.toward_viewer().to_array(),
             right: rays.right.extend(0.0).to_array(),
             down: rays.down.extend(0.0).to_array(),
             corner: rays.corner.extend(0.0).to_array(),

@@ -75,12 +75,17 @@ pub struct SplitImage {
 /// # Errors
 /// [`GpuError::Failed`] for a scale that does not divide the camera's size.
 pub fn indirect_camera(camera: &scene::Camera, settings: &SplitSettings) -> Result<scene::Camera, GpuError> {
-    let (w, h) = (camera.width, camera.height);
+    let (width, height) = indirect_size((camera.width, camera.height), settings)?;
+    Ok(scene::Camera { width, height, ..*camera })
+}
+
+/// The size the EnvIndirects are shaded at for a frame of `(w, h)` pixels.
+fn indirect_size((w, h): (u32, u32), settings: &SplitSettings) -> Result<(u32, u32), GpuError> {
     let f = settings.indirect_scale;
     if f == 0 || !w.is_multiple_of(f) || !h.is_multiple_of(f) {
         return Err(GpuError::Failed(format!("EnvIndirects at 1/{f} of {w}x{h}: the scale must divide both sides")));
     }
-    Ok(scene::Camera { width: w / f, height: h / f, ..*camera })
+    Ok((w / f, h / f))
 }
 
 /// Renders a split frame over `receivers` (the full-resolution G-buffer and its points) and
@@ -98,12 +103,14 @@ pub fn render_split(
     indirect: &dyn ShadowTechnique,
     settings: &SplitSettings,
 ) -> Result<SplitImage, GpuError> {
-    let low_camera = indirect_camera(&receivers.gbuffer.camera, settings)?;
+    let (lw, lh) = indirect_size(receivers.gbuffer.size(), settings)?;
     let (low_gb, low_points, low_receivers);
     let low = if settings.indirect_scale == 1 {
         receivers
     } else {
-        low_gb = passes.gbuffer.render(gpu, geometry, &low_camera)?;
+        let mut encoder = gpu.encoder("low gbuffer");
+        low_gb = passes.gbuffer.record_view(gpu, &mut encoder, geometry, &receivers.gbuffer.view.resized(lw, lh))?;
+        gpu.submit(encoder);
         low_points = low_gb.read_points(gpu)?;
         low_receivers = Receivers::new(&low_gb, &low_points);
         &low_receivers
@@ -148,8 +155,7 @@ pub fn record_split(
     settings: &SplitSettings,
 ) -> Result<SplitImage, GpuError> {
     let gb = receivers.gbuffer;
-    let low_camera = indirect_camera(&gb.camera, settings)?;
-    if low.gbuffer.size() != (low_camera.width, low_camera.height) {
+    if low.gbuffer.size() != indirect_size(gb.size(), settings)? {
         return Err(GpuError::Failed(format!(
             "EnvIndirects at 1/{} of {:?}: low receivers of {:?}",
             settings.indirect_scale,

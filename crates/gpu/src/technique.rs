@@ -124,8 +124,8 @@ impl<'a> Receivers<'a> {
     }
 
     /// The receivers of `gbuffer` as the CPU can know them without waiting: `bounds`, a box
-    /// that holds every visible point (e.g. [`conservative_bounds`] of the scene and the
-    /// camera), and the GPU's reduction of them left on the GPU (`stats`,
+    /// that holds every visible point (e.g. [`crate::conservative_bounds`] of the scene and
+    /// the view), and the GPU's reduction of them left on the GPU (`stats`,
     /// [`crate::PendingStats::on_gpu`]), which gates each light's passes and gives maps their
     /// focus. [`Receivers::any_faces`] answers yes for every light: the GPU decides.
     #[must_use]
@@ -160,35 +160,6 @@ impl<'a> Receivers<'a> {
         }
         self.points.iter().any(|(p, n)| p.is_finite() && light.reaches(*p, *n))
     }
-}
-
-/// A box that holds every point `camera` can see of a scene inside `scene` (a box), or `None`
-/// when nothing of it is in front of the camera: the scene's box clipped to the box of the view
-/// pyramid that reaches its farthest corner, widened by a millionth of its diagonal against the
-/// rounding of interpolated positions. What the CPU knows of the receivers without the G-buffer.
-#[must_use]
-pub fn conservative_bounds(scene: (Vec3, Vec3), camera: &scene::Camera) -> Option<(Vec3, Vec3)> {
-    let (lo, hi) = scene;
-    if !(lo.is_finite() && hi.is_finite() && lo.cmple(hi).all()) {
-        return None;
-    }
-    let (right, up, forward) = camera.basis();
-    let corners = (0..8).map(|k| Vec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), hi, lo));
-    let far = corners.map(|c| (c - camera.eye).dot(forward)).fold(f32::NEG_INFINITY, f32::max);
-    if far.is_nan() || far <= 0.0 {
-        return None;
-    }
-    let tx = (camera.hfov_degrees.to_radians() * 0.5).tan();
-    let ty = tx * camera.height as f32 / camera.width.max(1) as f32;
-    let (mut flo, mut fhi) = (camera.eye, camera.eye);
-    for (sx, sy) in [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)] {
-        let c = camera.eye + far * (forward + right * (sx * tx) + up * (sy * ty));
-        flo = flo.min(c);
-        fhi = fhi.max(c);
-    }
-    let margin = Vec3::splat((hi - lo).length() * 1e-6);
-    let (a, b) = (lo.max(flo) - margin, hi.min(fhi) + margin);
-    (a.is_finite() && b.is_finite() && a.cmple(b).all()).then_some((a, b))
 }
 
 /// Sphere around what the camera sees: the mean visible point and the 95th percentile of the
@@ -625,51 +596,6 @@ impl ShadowTechnique for PrecomputedVisibility {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Every point of the box the camera can see lies in the bounds, at 1e-3, 1 and 1e4 m;
-    /// nothing in front of the camera and non-finite boxes give none.
-    #[test]
-    fn conservative_bounds_hold_every_visible_point_of_the_box() {
-        for scale in [1e-3f32, 1.0, 1e4] {
-            let camera = scene::Camera {
-                eye: Vec3::new(0.0, 2.0, 6.0) * scale,
-                target: Vec3::ZERO,
-                up: Vec3::Y,
-                hfov_degrees: 50.0,
-                width: 160,
-                height: 90,
-            };
-            let scene = (Vec3::new(-20.0, -1.0, -30.0) * scale, Vec3::new(20.0, 3.0, 2.0) * scale);
-            let (lo, hi) = conservative_bounds(scene, &camera).unwrap();
-            assert!(lo.cmpge(scene.0 - scale * 1e-3).all() && hi.cmple(scene.1 + scale * 1e-3).all());
-            // smaller than the box: the view cuts it
-            assert!((hi - lo).length() < (scene.1 - scene.0).length());
-            let (right, up, forward) = camera.basis();
-            let tx = (camera.hfov_degrees.to_radians() * 0.5).tan();
-            let ty = tx * 90.0 / 160.0;
-            let mut seen = 0;
-            let mut state = 12345u32;
-            let mut next = || {
-                state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-                (state >> 8) as f32 / (1u32 << 24) as f32
-            };
-            for _ in 0..20_000 {
-                let p = scene.0 + (scene.1 - scene.0) * Vec3::new(next(), next(), next());
-                let v = p - camera.eye;
-                let z = v.dot(forward);
-                if z > 0.0 && v.dot(right).abs() <= tx * z && v.dot(up).abs() <= ty * z {
-                    seen += 1;
-                    assert!(p.cmpge(lo).all() && p.cmple(hi).all(), "{p} outside {lo} .. {hi}");
-                }
-            }
-            assert!(seen > 100, "{seen} points seen");
-        }
-        let camera =
-            scene::Camera { eye: Vec3::ZERO, target: Vec3::Z, up: Vec3::Y, hfov_degrees: 60.0, width: 4, height: 4 };
-        assert_eq!(conservative_bounds((Vec3::splat(-3.0), Vec3::new(3.0, 3.0, -1.0)), &camera), None);
-        assert_eq!(conservative_bounds((Vec3::splat(f32::NAN), Vec3::ONE), &camera), None);
-        assert_eq!(conservative_bounds((Vec3::ONE, Vec3::ZERO), &camera), None);
-    }
 
     #[test]
     fn skip_reasons_and_culled_work_add_up_per_kind() {

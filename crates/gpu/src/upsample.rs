@@ -133,7 +133,7 @@ impl UpsamplePass {
         }
         let s = settings;
         let uniform = Uniform {
-            eye: high_gb.camera.eye.extend(1.0).to_array(),
+            eye: high_gb.view.eye().extend(1.0).to_array(),
             inv_two_sigma2: [
                 inverse("normal", s.sigma_normal)?,
                 inverse("depth", s.sigma_depth)?,

@@ -185,7 +185,32 @@ struct FootprintVertex {
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct ViewUniform {
     view_proj: [[f32; 4]; 4],
+    // w = 1: the eye of a perspective; w = 0: a point behind every receiver of an orthographic
+    // view, from which depths are measured along `forward`
     eye: [f32; 4],
+    // the orthographic view's axis (w unused)
+    forward: [f32; 4],
+}
+
+/// The volume pass's view: `view`'s pixels, depths measured from its eye (or, orthographic,
+/// from a plane behind every receiver within `bounds`).
+fn view_uniform(view: &gpu::View, view_proj: &Mat4, bounds: Option<(Vec3, Vec3)>, extent: f32) -> ViewUniform {
+    let forward = view.forward();
+    let eye = if view.is_orthographic() {
+        let (lo, hi) = bounds.unwrap_or((view.eye(), view.eye()));
+        let nearest = (0..8)
+            .map(|k| Vec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), hi, lo))
+            .map(|c| (c - view.eye()).dot(forward))
+            .fold(0.0f32, f32::min);
+        (view.eye() + forward * (nearest - extent)).extend(0.0)
+    } else {
+        view.eye().extend(1.0)
+    };
+    ViewUniform {
+        view_proj: view_proj.to_cols_array_2d(),
+        eye: eye.to_array(),
+        forward: forward.extend(0.0).to_array(),
+    }
 }
 
 /// The compute path's R32Float sum of edge terms (zero-initialized).
@@ -461,9 +486,8 @@ impl ShadowTechnique for Wedges {
         target: &wgpu::TextureView,
     ) -> Result<ShadowPassReport, GpuError> {
         let gb = receivers.gbuffer;
-        let camera = &gb.camera;
         let extent = self.extent(receivers.bounds);
-        let view_proj = gpu::view_projection_infinite(camera, extent * 1e-6);
+        let view_proj = gb.view.unclipped_projection(extent * 1e-6);
         let plan = self.plan(light, receivers.bounds, &view_proj);
         let device = &gpu.device;
         let volume: Vec<[f32; 3]> = plan.volume.iter().flatten().map(|v| v.to_array()).collect();
@@ -494,7 +518,7 @@ impl ShadowTechnique for Wedges {
             }
             LightShape::Sphere { center, radius } => [center.extend(1.0).to_array(), [1.0, radius, cosine, 0.0]],
         };
-        let view = ViewUniform { view_proj: view_proj.to_cols_array_2d(), eye: camera.eye.extend(1.0).to_array() };
+        let view = view_uniform(&gb.view, &view_proj, receivers.bounds, extent);
         let view_buf = buffer("wedge view", bytemuck::bytes_of(&view), wgpu::BufferUsages::UNIFORM);
         let light_buf = buffer("wedge light", bytemuck::cast_slice(&light_params), wgpu::BufferUsages::UNIFORM);
         let edge_buf = buffer("wedge edges", bytemuck::cast_slice(&edges), wgpu::BufferUsages::STORAGE);

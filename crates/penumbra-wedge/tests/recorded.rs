@@ -124,7 +124,7 @@ fn wedges_gated_on_the_gpu_and_planned_for_a_looser_box_equal_wedges_planned_for
         .iter()
         .flat_map(|o| &o.mesh.positions)
         .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
-    let bounds = gpu::conservative_bounds((lo, hi), &scene.camera);
+    let bounds = gpu::conservative_bounds((lo, hi), &gb.view);
     let (exact, loose) = (read.bounds.unwrap(), bounds.unwrap());
     assert!(loose.0.cmple(exact.0).all() && loose.1.cmpge(exact.1).all(), "{loose:?} does not hold {exact:?}");
     let left = Receivers::on_gpu(&gb, bounds, on_gpu);

@@ -372,3 +372,119 @@ fn cosine_weighting_follows_a_low_light_as_a_lambertian_receiver_sees_it() {
         "weighted {w_mean}/{w_soft} vs plain on its own measure {u_mean}/{u_soft}"
     );
 }
+
+/// `p` with its depth reversed (z' = w - z): the G-buffer pass keeps the largest depth.
+fn reversed(p: glam::Mat4) -> glam::Mat4 {
+    glam::Mat4::from_cols(
+        glam::Vec4::X,
+        glam::Vec4::Y,
+        glam::Vec4::new(0.0, 0.0, -1.0, 0.0),
+        glam::Vec4::new(0.0, 0.0, 1.0, 1.0),
+    ) * p
+}
+
+/// The wedges over a G-buffer rendered from `view`, with the points it read back.
+fn render_view(scene: Scene, view: &gpu::View, light: LightShape) -> Frame {
+    let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
+    let geometry = SceneGeometry::upload(&gpu, &scene).unwrap();
+    let mut encoder = gpu.encoder("gbuffer");
+    let gb = GBufferPass::new(&gpu).record_view(&gpu, &mut encoder, &geometry, view).unwrap();
+    gpu.submit_and_wait(encoder).unwrap();
+    let points = gb.read_points(&gpu).unwrap();
+    let technique = Wedges::new(&gpu, &scene, WedgeSettings::default());
+    let (w, h) = gb.size();
+    let vis = Visibility::new(&gpu, w, h, 1).unwrap();
+    let report = technique.write_visibility(&gpu, &Receivers::new(&gb, &points), &light, &vis.layer(0)).unwrap();
+    let wedges = vis.read(&gpu, 0).unwrap();
+    Frame { gpu, scene, points, wedges, report }
+}
+
+/// A renderer's own views, not `scene::Camera`'s: jittered, off-centre with a far plane,
+/// left-handed (its front faces wind the other way) and orthographic. Each shadows as the
+/// CPU mirror and the ray-traced light do at the pixels it sees.
+#[test]
+fn views_of_any_projection_shadow_as_the_cpu_mirror_and_the_ray_traced_light() {
+    use glam::camera::{lh, rh};
+    let s = scene("three_boxes", 160, 120);
+    let c = s.camera;
+    let light = sun(4.0);
+    let (fov_y, aspect) = {
+        let tan_x = (c.hfov_degrees.to_radians() * 0.5).tan();
+        (2.0 * (tan_x * c.height as f32 / c.width as f32).atan(), c.width as f32 / c.height as f32)
+    };
+    let near = 0.05;
+    let look = rh::view::look_at_mat4(c.eye, c.target, c.up);
+    // the orthographic view looks down on what the camera frames, where the shadows fall
+    let reach = c.eye.distance(c.target);
+    let half = reach * (c.hfov_degrees.to_radians() * 0.5).tan();
+    let from = c.target + Vec3::new(0.1, 1.0, 0.2).normalize() * reach;
+    let views = [
+        ("jittered", gpu::View::from_camera(&c, 1e-4).jittered(0.37, -0.21)),
+        (
+            "off-centre",
+            gpu::View::new(
+                look,
+                reversed(rh::proj::directx::frustum(-0.02, 0.035, -0.015, 0.03, near, 60.0)),
+                (160, 120),
+            )
+            .unwrap(),
+        ),
+        (
+            "left-handed",
+            gpu::View::new(
+                lh::view::look_at_mat4(c.eye, c.target, c.up),
+                lh::proj::directx::perspective_infinite_reverse(fov_y, aspect, near),
+                (160, 120),
+            )
+            .unwrap(),
+        ),
+        (
+            "orthographic",
+            gpu::View::new(
+                rh::view::look_at_mat4(from, c.target, Vec3::Z),
+                reversed(rh::proj::directx::orthographic(-half, half, -0.75 * half, 0.75 * half, 0.0, 4.0 * reach)),
+                (160, 120),
+            )
+            .unwrap(),
+        ),
+    ];
+    for (name, view) in views {
+        assert_eq!(view.is_mirrored(), name == "left-handed", "{name}");
+        assert_eq!(view.is_orthographic(), name == "orthographic", "{name}");
+        let f = render_view(s.clone(), &view, light);
+        let seen = f.points.iter().filter(|(p, _)| p.is_finite()).count();
+        assert!(seen > 5000, "{name}: {seen} pixels see the scene");
+        let (mean, _, bad, soft) = compare(&f.wedges, &f.mirror(&light), 0.02);
+        assert!(soft > 50, "{name}: {soft} penumbra pixels");
+        assert!(mean < 0.004 && bad < 0.01, "{name}: mirror mean {mean}, {:.2} % off by > 0.02", bad * 100.0);
+        let (mean, soft_mean, _, _) = compare(&f.wedges, &f.truth(&light), 0.05);
+        assert!(mean < 0.002 && soft_mean < 0.03, "{name}: traced mean {mean}, in penumbrae {soft_mean}");
+    }
+}
+
+/// A renderer with only depth and its view: the G-buffer made from them
+/// (`gpu::DepthGBufferPass`) shadows as the rasterized one.
+#[test]
+fn a_gbuffer_made_from_depth_shadows_as_the_rasterized_one() {
+    let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
+    let s = scene("spheres_box", 160, 120);
+    let geometry = SceneGeometry::upload(&gpu, &s).unwrap();
+    let mut encoder = gpu.encoder("gbuffers");
+    let rasterized = GBufferPass::new(&gpu).record(&gpu, &mut encoder, &geometry, &s.camera).unwrap();
+    let made =
+        gpu::DepthGBufferPass::new(&gpu).record(&gpu, &mut encoder, &rasterized.depth, &rasterized.view, None).unwrap();
+    gpu.submit_and_wait(encoder).unwrap();
+    let technique = Wedges::new(&gpu, &s, WedgeSettings::default());
+    let light = sun(4.0);
+    let layer = |gb: &gpu::GBuffer| {
+        let points = gb.read_points(&gpu).unwrap();
+        let vis = Visibility::new(&gpu, 160, 120, 1).unwrap();
+        technique.write_visibility(&gpu, &Receivers::new(gb, &points), &light, &vis.layer(0)).unwrap();
+        vis.read(&gpu, 0).unwrap()
+    };
+    let (a, b) = (layer(&rasterized), layer(&made));
+    let b: Vec<Option<f32>> = b.into_iter().map(Some).collect();
+    let (mean, _, bad, soft) = compare(&a, &b, 0.02);
+    assert!(soft > 100, "{soft} penumbra pixels");
+    assert!(mean < 1e-3 && bad < 0.005, "mean {mean}, {:.2} % of pixels off by > 0.02", bad * 100.0);
+}

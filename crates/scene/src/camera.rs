@@ -58,7 +58,7 @@ impl Camera {
 }
 
 /// Precomputed ray generation of a [`Camera`].
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CameraRays {
     /// ray origin
     pub eye: Vec3,

@@ -288,7 +288,14 @@ pub fn run(map: Option<&Path>, out: &Path, frames: usize, (w, h): (u32, u32)) ->
     let depth = target("depth", wgpu::TextureFormat::Depth32Float)?;
     let hdr = target("image", gpu::HDR_FORMAT)?;
     let visibility = Visibility::allocate(&gpu, w, h, shapes.len() as u32)?;
-    let view_proj = gpu::view_projection_reverse(&camera, 1e-3);
+    // the renderer's own matrices (right-handed, reversed infinite depth); the toolkit takes
+    // them as they are, jittered or orthographic ones too
+    let world_to_view = glam::camera::rh::view::look_at_mat4(camera.eye, camera.target, Vec3::Y);
+    let aspect = w as f32 / h as f32;
+    let fov_y = 2.0 * ((camera.hfov_degrees.to_radians() * 0.5).tan() / aspect).atan();
+    let projection = glam::camera::rh::proj::directx::perspective_infinite_reverse(fov_y, aspect, 1e-3);
+    let camera_view = gpu::View::new(world_to_view, projection, (w, h))?;
+    let view_proj = camera_view.view_projection();
     let view: Vec<f32> = view_proj.to_cols_array().into_iter().chain(camera.eye.extend(1.0).to_array()).collect();
     let buffer = |label, contents: &[u8], usage| {
         device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
@@ -391,7 +398,7 @@ pub fn run(map: Option<&Path>, out: &Path, frames: usize, (w, h): (u32, u32)) ->
             normal: normal.clone(),
             geometric_normal: geometric.clone(),
             depth: depth.clone(),
-            camera,
+            view: camera_view,
         };
         let weber = WeberInput { lights: &shade, ambient: Some(&decomposition.ambient_sh), fraction: WEBER_FRACTION };
         let pending = reduction.record(&gpu, &mut encoder, &gbuffer, &shapes, Some(weber))?;
@@ -400,7 +407,7 @@ pub fn run(map: Option<&Path>, out: &Path, frames: usize, (w, h): (u32, u32)) ->
         // every light's visibility recorded into the renderer's encoder, then its shading: the
         // reduction stays on the GPU, gates each light's draws and fits the orthographic maps
         // (no wait for it)
-        let bounds = gpu::conservative_bounds(scene_box(&scene), &gbuffer.camera);
+        let bounds = gpu::conservative_bounds(scene_box(&scene), &gbuffer.view);
         let receivers = Receivers::on_gpu(&gbuffer, bounds, pending.on_gpu().clone());
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         visibility.record_clear(&mut encoder);
