@@ -1,5 +1,5 @@
 //! What a frame costs, counted over many frames: queue submissions, CPU waits, bytes mapped
-//! back, pipelines created after the first frame (from `gpu::GpuCounters`), the CPU's time
+//! back, pipelines created after the first frame, gate passes (from `gpu::GpuCounters`), the CPU's time
 //! outside waits, GPU time between two timestamps around the frame, and wall time.
 //!
 //! The measurement wraps the frame: the timestamps go in submissions of their own before and
@@ -24,6 +24,8 @@ pub struct FrameStats {
     pub readback_bytes_per_frame: f64,
     /// Pipelines created over all measured frames.
     pub pipelines_created_after_first_frame: u64,
+    /// Gate passes recorded (one a gated light and technique).
+    pub gate_passes_per_frame: f64,
     /// CPU time outside waits: recording, planning, uploads.
     pub cpu_record_ms: f64,
     /// GPU time from the frame's first command to its last (timestamps), `None` without
@@ -104,6 +106,7 @@ pub fn measure_frames<E: From<GpuError>>(
     let stamps = Stamps::new(gpu);
     let (mut submits, mut waits, mut bytes, mut cpu, mut gpu_ms, mut wall) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut gates = Vec::new();
     let mut pipelines_after_first = 0;
     for k in 0..=frames {
         if let Some(s) = &stamps {
@@ -126,6 +129,7 @@ pub fn measure_frames<E: From<GpuError>>(
         submits.push(d.submits as f64);
         waits.push(d.waits as f64);
         bytes.push(d.readback_bytes as f64);
+        gates.push(d.gate_passes as f64);
         cpu.push(elapsed.saturating_sub(Duration::from_nanos(d.wait_ns)).as_secs_f64() * 1e3);
         wall.push(elapsed.as_secs_f64() * 1e3);
         gpu_ms.extend(ms);
@@ -136,6 +140,7 @@ pub fn measure_frames<E: From<GpuError>>(
         waits_per_frame: median(waits),
         readback_bytes_per_frame: median(bytes),
         pipelines_created_after_first_frame: pipelines_after_first,
+        gate_passes_per_frame: median(gates),
         cpu_record_ms: median(cpu),
         gpu_ms: (!gpu_ms.is_empty()).then(|| median(gpu_ms)),
         wall_ms: median(wall),

@@ -211,6 +211,9 @@ fn frame_json_counts_what_a_moving_frame_costs() {
     // the receivers' statistics, not their points: at most the 4 KiB
     assert!(v["readback_bytes_per_frame"].as_f64().is_some_and(|b| b > 0.0 && b <= 4096.0), "{v}");
     assert!(v["gpu_ms"].is_null() || v["gpu_ms"].as_f64().is_some_and(|g| g >= 0.0), "{v}");
+    // a gate pass a gated light, not one a pass of its
+    let lights = v["lights"].as_f64().unwrap();
+    assert!(v["gate_passes_per_frame"].as_f64().is_some_and(|g| g > 0.0 && g <= lights), "{v}");
     assert!(v["adapter"].as_str().is_some_and(|a| !a.is_empty()), "{v}");
     // every light is shadowed or skipped with a reason
     let skipped: u64 =

@@ -77,6 +77,8 @@ pub struct GpuCounters {
     pub pipelines: u64,
     /// Nanoseconds the CPU spent in those waits.
     pub wait_ns: u64,
+    /// Gate passes recorded ([`crate::Gate`]): one a gated light per technique call.
+    pub gate_passes: u64,
 }
 
 /// What happened between two snapshots, `later - earlier` (saturating: never negative).
@@ -89,6 +91,7 @@ impl std::ops::Sub for GpuCounters {
             readback_bytes: self.readback_bytes.saturating_sub(o.readback_bytes),
             pipelines: self.pipelines.saturating_sub(o.pipelines),
             wait_ns: self.wait_ns.saturating_sub(o.wait_ns),
+            gate_passes: self.gate_passes.saturating_sub(o.gate_passes),
         }
     }
 }
@@ -100,6 +103,7 @@ struct Counters {
     readback_bytes: AtomicU64,
     pipelines: AtomicU64,
     wait_ns: AtomicU64,
+    gate_passes: AtomicU64,
 }
 
 /// The environment variable [`Gpu::new`] reads an adapter name from (as `--adapter`).
@@ -258,7 +262,13 @@ impl Gpu {
             readback_bytes: c.readback_bytes.load(Ordering::Relaxed),
             pipelines: c.pipelines.load(Ordering::Relaxed),
             wait_ns: c.wait_ns.load(Ordering::Relaxed),
+            gate_passes: c.gate_passes.load(Ordering::Relaxed),
         }
+    }
+
+    /// Counts a gate pass recorded.
+    pub(crate) fn count_gate_pass(&self) {
+        self.counters.gate_passes.fetch_add(1, Ordering::Relaxed);
     }
 
     /// Submits `encoder` without waiting.

@@ -181,6 +181,7 @@ impl Gate<'_> {
                 wgpu::BindGroupEntry { binding: 3, resource: args.as_entire_binding() },
             ],
         });
+        gpu.count_gate_pass();
         let mut pass =
             encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("gate"), timestamp_writes: None });
         pass.set_pipeline(&self.stats.gate);

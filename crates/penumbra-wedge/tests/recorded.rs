@@ -144,6 +144,8 @@ fn wedges_gated_on_the_gpu_and_planned_for_a_looser_box_equal_wedges_planned_for
         record_visibility(&gpu, &mut encoder, &wedges, &left, &all, &[], &vis).unwrap();
         let during = gpu.counters() - before;
         assert_eq!((during.submits, during.waits, during.readback_bytes, during.pipelines), (0, 0, 0, 0));
+        // one gate a light: its volume, wedges (or bins) and resolve behind it
+        assert_eq!(during.gate_passes, all.len() as u64);
         gpu.submit(encoder);
         for (k, a) in want.iter().enumerate() {
             let b = vis.read(&gpu, k as u32).unwrap();

@@ -248,7 +248,7 @@ enum Class {
 type Classifier = Box<dyn Fn(&Chunk) -> Class>;
 
 /// A map's texture, views and passes, made before its passes are recorded.
-struct Prepared<'a> {
+pub(crate) struct Prepared<'a> {
     map: ShadowMap,
     layer_views: Vec<wgpu::TextureView>,
     view_buffers: Vec<wgpu::Buffer>,
@@ -258,6 +258,28 @@ struct Prepared<'a> {
     /// Pipelines for chunks inside a view and across its edge.
     inside: &'a wgpu::RenderPipeline,
     straddle: &'a wgpu::RenderPipeline,
+}
+
+/// A prepared map's depth draws: per view, the runs of chunks inside it, then those across its
+/// edge, as calls; how many of each per view; the triangles each view draws.
+pub(crate) struct DepthCalls {
+    pub(crate) args: Vec<Indirect>,
+    runs: Vec<(usize, usize)>,
+    drawn: Vec<u32>,
+}
+
+impl DepthCalls {
+    pub(crate) fn of(geometry: &ShadowGeometry, p: &Prepared) -> Self {
+        let mut calls = Self { args: Vec::new(), runs: Vec::new(), drawn: Vec::new() };
+        for class in &p.classes {
+            let (inside, a) = geometry.runs(|c| class[c] == Class::Inside);
+            let (straddle, b) = geometry.runs(|c| class[c] == Class::Straddle);
+            calls.drawn.push(a + b);
+            calls.runs.push((inside.len(), straddle.len()));
+            calls.args.extend(inside.into_iter().chain(straddle).map(Indirect::draw));
+        }
+        calls
+    }
 }
 
 impl Prepared<'_> {
@@ -413,12 +435,12 @@ impl ShadowMapper {
         settings: &ShadowSettings,
     ) -> Result<ShadowMap, GpuError> {
         let mut p = self.prepare(gpu, geometry, light, technique, settings, None)?;
-        let mut drawn = Vec::new();
-        let (time, clock) =
-            gpu.measure(|encoder| drawn = self.record_passes(gpu, encoder, geometry, &p, OnGpu::default()))?;
+        let depth = DepthCalls::of(geometry, &p);
+        let calls = Calls::direct(depth.args.clone());
+        let (time, clock) = gpu.measure(|encoder| self.record_passes(encoder, geometry, &p, &depth, (&calls, 0)))?;
         p.map.time = time;
         p.map.clock = clock;
-        Ok(p.finish(drawn))
+        Ok(p.finish(depth.drawn))
     }
 
     /// Records the shadow map of `light` into `encoder` without submitting it, so that many
@@ -444,8 +466,25 @@ impl ShadowMapper {
         target: Option<(&wgpu::Texture, u32)>,
         on_gpu: OnGpu<'_>,
     ) -> Result<ShadowMap, GpuError> {
-        let mut p = self.prepare(gpu, geometry, light, technique, settings, target)?;
-        let fit = match (technique, light, on_gpu.stats) {
+        let p = self.prepare(gpu, geometry, light, technique, settings, target)?;
+        let depth = DepthCalls::of(geometry, &p);
+        let calls = Calls::new(gpu, encoder, on_gpu.gate, depth.args.clone());
+        Ok(self.record_prepared(gpu, encoder, geometry, p, (light, settings, on_gpu.stats), (&depth, &calls, 0)))
+    }
+
+    /// Records a prepared map: its focus fitted on the GPU (an orthographic map without a
+    /// focus of its own, where the receivers' `stats` are given), then its depth passes
+    /// (`depth`'s calls, the first being call `first` of `calls`).
+    pub(crate) fn record_prepared(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        geometry: &ShadowGeometry,
+        mut p: Prepared<'_>,
+        (light, settings, stats): (&ShadowLight, &ShadowSettings, Option<&GpuStats>),
+        (depth, calls, first): (&DepthCalls, &Calls, usize),
+    ) -> ShadowMap {
+        let fit = match (p.map.technique, light, stats) {
             (Technique::Orthographic, ShadowLight::Distant { direction }, Some(stats)) if settings.focus.is_none() => {
                 Some(self.record_focus(gpu, encoder, geometry, *direction, settings.resolution, stats))
             }
@@ -455,8 +494,8 @@ impl ShadowMapper {
             encoder.copy_buffer_to_buffer(fit, 0, view, 0, std::mem::size_of::<ViewUniform>() as u64);
         }
         p.map.gpu_view = fit;
-        let drawn = self.record_passes(gpu, encoder, geometry, &p, on_gpu);
-        Ok(p.finish(drawn))
+        self.record_passes(encoder, geometry, &p, depth, (calls, first));
+        p.finish(depth.drawn.clone())
     }
 
     /// Records the orthographic view of a map towards `direction` fitted to the receivers'
@@ -530,7 +569,7 @@ impl ShadowMapper {
     }
 
     /// Everything a map's passes need, made before recording them.
-    fn prepare(
+    pub(crate) fn prepare(
         &self,
         gpu: &Gpu,
         geometry: &ShadowGeometry,
@@ -695,29 +734,17 @@ impl ShadowMapper {
         Ok(Prepared { map, layer_views, view_buffers, binds, classes, inside, straddle })
     }
 
-    /// Records a prepared map's depth passes (gated by `on_gpu.gate`); the triangles drawn
-    /// per view.
+    /// Records a prepared map's depth passes, issuing `depth`'s calls from call `first` of
+    /// `calls` on.
     fn record_passes(
         &self,
-        gpu: &Gpu,
         encoder: &mut wgpu::CommandEncoder,
         geometry: &ShadowGeometry,
         p: &Prepared,
-        on_gpu: OnGpu<'_>,
-    ) -> Vec<u32> {
-        // per view, the runs of chunks inside it, then those across its edge
-        let mut drawn = vec![0; p.classes.len()];
-        let mut runs = Vec::with_capacity(p.classes.len());
-        let mut args = Vec::new();
-        for (k, class) in p.classes.iter().enumerate() {
-            let (inside, a) = geometry.runs(|c| class[c] == Class::Inside);
-            let (straddle, b) = geometry.runs(|c| class[c] == Class::Straddle);
-            drawn[k] = a + b;
-            runs.push((inside.len(), straddle.len()));
-            args.extend(inside.into_iter().chain(straddle).map(Indirect::draw));
-        }
-        let calls = Calls::new(gpu, encoder, on_gpu.gate, args);
-        let mut call = 0;
+        depth: &DepthCalls,
+        (calls, first): (&Calls, usize),
+    ) {
+        let mut call = first;
         for (k, bind) in p.binds.iter().enumerate() {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("shadow depth"),
@@ -731,7 +758,7 @@ impl ShadowMapper {
             });
             pass.set_bind_group(0, bind, &[]);
             geometry.set_vertices(&mut pass);
-            let (inside, straddle) = runs[k];
+            let (inside, straddle) = depth.runs[k];
             pass.set_pipeline(p.inside);
             for _ in 0..inside {
                 calls.draw(&mut pass, call);
@@ -743,7 +770,6 @@ impl ShadowMapper {
                 call += 1;
             }
         }
-        drawn
     }
 
     /// Writes `map`'s visibility of each G-buffer pixel into `target` (a visibility layer):
@@ -759,13 +785,16 @@ impl ShadowMapper {
         target: &wgpu::TextureView,
     ) -> Result<(), GpuError> {
         let mut encoder = gpu.encoder("shadow visibility");
-        self.record_visibility(gpu, &mut encoder, map, gbuffer, VisibilityTarget::Layer(target), 0.0, None);
+        let calls = Calls::direct(vec![Indirect::draw(0..3)]);
+        let target = VisibilityTarget::Layer(target);
+        self.record_visibility(gpu, &mut encoder, map, gbuffer, target, 0.0, (&calls, 0));
         gpu.submit_and_wait(encoder)
     }
 
     /// Records `map`'s visibility pass into `encoder`, writing a visibility layer or adding into
     /// an accumulator (cleared first when asked). `half_angle` is the light's (radians), used by
-    /// PCSS (`settings.pcss`) on orthographic maps; `gate`: the light's, when the frame gates it.
+    /// PCSS (`settings.pcss`) on orthographic maps; its full-screen triangle is call `k` of
+    /// `calls` (`Indirect::draw(0..3)`; gated when the frame gates the light).
     #[allow(clippy::too_many_arguments)]
     pub fn record_visibility(
         &self,
@@ -775,7 +804,7 @@ impl ShadowMapper {
         gbuffer: &GBuffer,
         target: VisibilityTarget<'_>,
         half_angle: f32,
-        gate: Option<Gate<'_>>,
+        (calls, k): (&Calls, usize),
     ) {
         // the view below starts at the map's first layer
         let params = map.lookup_params(half_angle, 0);
@@ -788,7 +817,6 @@ impl ShadowMapper {
             let size = std::mem::size_of::<ViewUniform>() as u64;
             encoder.copy_buffer_to_buffer(view, 0, &buffer, FIRST_VIEW_OFFSET, size);
         }
-        let calls = Calls::new(gpu, encoder, gate, vec![Indirect::draw(0..3)]);
         let position = gbuffer.position.create_view(&Default::default());
         let normal = gbuffer.geometric_normal.create_view(&Default::default());
         let shadow = map.texture.create_view(&wgpu::TextureViewDescriptor {
@@ -828,6 +856,6 @@ impl ShadowMapper {
         });
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &bind, &[]);
-        calls.draw(&mut pass, 0);
+        calls.draw(&mut pass, k);
     }
 }

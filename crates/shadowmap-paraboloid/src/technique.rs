@@ -2,7 +2,7 @@
 //! PCSS on it, or the mean of N hard maps from directions spread over the light (Heckbert and
 //! Herf 1997, paper 000's reference method).
 
-use crate::mapper::{OnGpu, ShadowMapper, VisibilityTarget};
+use crate::mapper::{DepthCalls, ShadowMapper, VisibilityTarget};
 use crate::{ShadowLight, ShadowSettings, Technique, shadow_triangles};
 use glam::Vec3;
 use gpu::accumulate::{Accumulator, ResolvePass};
@@ -207,23 +207,43 @@ impl ShadowTechnique for MapTechnique {
         let size = receivers.gbuffer.size();
         let layers = ShadowMapper::view_count(&lights[0], self.technique);
         let scratch = self.scratch(gpu, size, (settings.resolution, layers), lights.len() > 1)?;
-        for (k, l) in lights.iter().enumerate() {
+        // every sample's calls (its depth draws, its visibility pass) and the resolve's go
+        // through one gate: one gate pass a light, however many samples
+        let into = Some((&scratch.map, 0));
+        let mut args = Vec::new();
+        let mut prepared = Vec::with_capacity(lights.len());
+        for l in &lights {
+            let p = shared.mapper.prepare(gpu, geometry, l, self.technique, &settings, into)?;
+            let depth = DepthCalls::of(geometry, &p);
+            let first = args.len();
+            args.extend(depth.args.iter().cloned());
+            args.push(gpu::Indirect::draw(0..3));
+            prepared.push((p, depth, first));
+        }
+        let resolve_call = args.len();
+        if scratch.accumulator.is_some() {
+            args.push(gpu::Indirect::draw(0..3));
+        }
+        let calls = gpu::Calls::new(gpu, encoder, gate, args);
+        let stats = receivers.on_gpu.as_ref();
+        for (k, (l, (p, depth, first))) in lights.iter().zip(prepared).enumerate() {
             // one map texture for all of them: the passes run in the order recorded
-            let on_gpu = OnGpu { gate, stats: receivers.on_gpu.as_ref() };
-            let into = Some((&scratch.map, 0));
-            let map = shared.mapper.record(gpu, encoder, geometry, l, self.technique, &settings, into, on_gpu)?;
+            let visibility_call = first + depth.args.len();
+            let lit = (l, &settings, stats);
+            let map = shared.mapper.record_prepared(gpu, encoder, geometry, p, lit, (&depth, &calls, first));
             primitives += u64::from(map.triangles_drawn());
             let out = match &scratch.accumulator {
                 Some(a) => VisibilityTarget::Add(a, k == 0),
                 None => VisibilityTarget::Layer(target),
             };
-            shared.mapper.record_visibility(gpu, encoder, &map, receivers.gbuffer, out, half_angle, gate);
+            let call = (&calls, visibility_call);
+            shared.mapper.record_visibility(gpu, encoder, &map, receivers.gbuffer, out, half_angle, call);
         }
         if let Some(a) = &scratch.accumulator {
             let scale = [1.0 / lights.len() as f32, 0.0, 0.0, 0.0];
-            let calls = gpu::Calls::new(gpu, encoder, gate, vec![gpu::Indirect::draw(0..3)]);
             let params = bytemuck::cast_slice(&scale);
-            shared.resolve.record(gpu, encoder, receivers.gbuffer, a, params, &[], Some((&calls, 0)), target);
+            let call = Some((&calls, resolve_call));
+            shared.resolve.record(gpu, encoder, receivers.gbuffer, a, params, &[], call, target);
         }
         Ok(ShadowPassReport { time: Duration::ZERO, clock: None, skipped: None, primitives, culled: Vec::new() })
     }

@@ -151,6 +151,8 @@ fn maps_fitted_and_gated_on_the_gpu_equal_maps_fitted_on_the_cpu() {
         let (want, _, reports) = recorded_any(&gpu, &technique, &read, lights);
         let (got, during, _) = recorded_any(&gpu, &technique, left, lights);
         assert_eq!((during.submits, during.waits, during.readback_bytes), (0, 0, 0), "{name}");
+        // one gate a light, whatever its samples' depth and visibility passes and the resolve
+        assert_eq!(during.gate_passes, lights.len() as u64, "{name}");
         for (k, (a, b)) in want.iter().zip(&got).enumerate() {
             let differ = a.iter().zip(b).filter(|(x, y)| x != y).count();
             assert_eq!(differ, 0, "{name}, light {k} (skipped on the CPU: {:?})", reports[k].skipped);
