@@ -15,6 +15,8 @@ pub struct View {
     size: (u32, u32),
     eye: Vec3,
     orthographic: bool,
+    // derived from the matrices once (`axis`): the wedges read it for every light
+    forward: Vec3,
     rays: scene::CameraRays,
     // the pinhole it was made from, if any: its own ray generation (`scene::Camera::rays`),
     // which the reference tracer shares, is kept bit for bit through `resized`
@@ -54,8 +56,17 @@ impl View {
             }
             p.as_vec3()
         };
-        let mut v =
-            Self { view, projection, size: (width, height), eye, orthographic, rays: zero_rays(), pinhole: None };
+        let mut v = Self {
+            view,
+            projection,
+            size: (width, height),
+            eye,
+            orthographic,
+            forward: Vec3::ZERO,
+            rays: zero_rays(),
+            pinhole: None,
+        };
+        v.forward = v.axis();
         v.rays = v.rays_from_matrices();
         Ok(v)
     }
@@ -66,15 +77,18 @@ impl View {
     pub fn from_camera(camera: &scene::Camera, near: f32) -> Self {
         let (fov_y, aspect, view) = crate::gbuffer::view_and_fov(camera);
         let projection = glam::camera::rh::proj::directx::perspective_infinite_reverse(fov_y, aspect, near);
-        Self {
+        let mut v = Self {
             view,
             projection,
             size: (camera.width.max(1), camera.height.max(1)),
             eye: camera.eye,
             orthographic: false,
+            forward: Vec3::ZERO,
             rays: camera.rays(),
             pinhole: Some(*camera),
-        }
+        };
+        v.forward = v.axis();
+        v
     }
 
     /// This view with its projection moved by (`dx`, `dy`) pixels (right, down): the jitter of a
@@ -84,6 +98,7 @@ impl View {
         let (w, h) = (self.size.0 as f32, self.size.1 as f32);
         let shift = Mat4::from_translation(Vec3::new(2.0 * dx / w, -2.0 * dy / h, 0.0));
         let mut v = Self { projection: shift * self.projection, pinhole: None, ..*self };
+        v.forward = v.axis();
         v.rays = v.rays_from_matrices();
         v
     }
@@ -141,6 +156,11 @@ impl View {
     /// taken not to mirror ([`View::is_mirrored`]), whatever its depth convention.
     #[must_use]
     pub fn forward(&self) -> Vec3 {
+        self.forward
+    }
+
+    /// [`View::forward`] from the matrices.
+    fn axis(&self) -> Vec3 {
         let m = self.view_projection().as_dmat4();
         let toward = row(&m, 0).truncate().cross(row(&m, 1).truncate());
         if self.orthographic {

@@ -260,25 +260,26 @@ pub(crate) struct Prepared<'a> {
     straddle: &'a wgpu::RenderPipeline,
 }
 
-/// A prepared map's depth draws: per view, the runs of chunks inside it, then those across its
-/// edge, as calls; how many of each per view; the triangles each view draws.
+/// A prepared map's depth draws: per view, how many runs of chunks inside it, then across its
+/// edge, are drawn, and the triangles it draws.
 pub(crate) struct DepthCalls {
-    pub(crate) args: Vec<Indirect>,
     runs: Vec<(usize, usize)>,
     drawn: Vec<u32>,
 }
 
 impl DepthCalls {
-    pub(crate) fn of(geometry: &ShadowGeometry, p: &Prepared) -> Self {
-        let mut calls = Self { args: Vec::new(), runs: Vec::new(), drawn: Vec::new() };
+    /// The depth draws of `p` and their calls, in the order its passes issue them.
+    pub(crate) fn of(geometry: &ShadowGeometry, p: &Prepared) -> (Self, Vec<Indirect>) {
+        let mut calls = Self { runs: Vec::new(), drawn: Vec::new() };
+        let mut args = Vec::new();
         for class in &p.classes {
             let (inside, a) = geometry.runs(|c| class[c] == Class::Inside);
             let (straddle, b) = geometry.runs(|c| class[c] == Class::Straddle);
             calls.drawn.push(a + b);
             calls.runs.push((inside.len(), straddle.len()));
-            calls.args.extend(inside.into_iter().chain(straddle).map(Indirect::draw));
+            args.extend(inside.into_iter().chain(straddle).map(Indirect::draw));
         }
-        calls
+        (calls, args)
     }
 }
 
@@ -435,8 +436,8 @@ impl ShadowMapper {
         settings: &ShadowSettings,
     ) -> Result<ShadowMap, GpuError> {
         let mut p = self.prepare(gpu, geometry, light, technique, settings, None)?;
-        let depth = DepthCalls::of(geometry, &p);
-        let calls = Calls::direct(depth.args.clone());
+        let (depth, args) = DepthCalls::of(geometry, &p);
+        let calls = Calls::direct(args);
         let (time, clock) = gpu.measure(|encoder| self.record_passes(encoder, geometry, &p, &depth, (&calls, 0)))?;
         p.map.time = time;
         p.map.clock = clock;
@@ -467,9 +468,9 @@ impl ShadowMapper {
         on_gpu: OnGpu<'_>,
     ) -> Result<ShadowMap, GpuError> {
         let p = self.prepare(gpu, geometry, light, technique, settings, target)?;
-        let depth = DepthCalls::of(geometry, &p);
-        let calls = Calls::new(gpu, encoder, on_gpu.gate, depth.args.clone());
-        Ok(self.record_prepared(gpu, encoder, geometry, p, (light, settings, on_gpu.stats), (&depth, &calls, 0)))
+        let (depth, args) = DepthCalls::of(geometry, &p);
+        let calls = Calls::new(gpu, encoder, on_gpu.gate, args);
+        Ok(self.record_prepared(gpu, encoder, geometry, p, (light, settings, on_gpu.stats), (depth, &calls, 0)))
     }
 
     /// Records a prepared map: its focus fitted on the GPU (an orthographic map without a
@@ -482,7 +483,7 @@ impl ShadowMapper {
         geometry: &ShadowGeometry,
         mut p: Prepared<'_>,
         (light, settings, stats): (&ShadowLight, &ShadowSettings, Option<&GpuStats>),
-        (depth, calls, first): (&DepthCalls, &Calls, usize),
+        (depth, calls, first): (DepthCalls, &Calls, usize),
     ) -> ShadowMap {
         let fit = match (p.map.technique, light, stats) {
             (Technique::Orthographic, ShadowLight::Distant { direction }, Some(stats)) if settings.focus.is_none() => {
@@ -494,8 +495,8 @@ impl ShadowMapper {
             encoder.copy_buffer_to_buffer(fit, 0, view, 0, std::mem::size_of::<ViewUniform>() as u64);
         }
         p.map.gpu_view = fit;
-        self.record_passes(encoder, geometry, &p, depth, (calls, first));
-        p.finish(depth.drawn.clone())
+        self.record_passes(encoder, geometry, &p, &depth, (calls, first));
+        p.finish(depth.drawn)
     }
 
     /// Records the orthographic view of a map towards `direction` fitted to the receivers'

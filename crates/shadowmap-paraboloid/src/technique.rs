@@ -214,11 +214,13 @@ impl ShadowTechnique for MapTechnique {
         let mut prepared = Vec::with_capacity(lights.len());
         for l in &lights {
             let p = shared.mapper.prepare(gpu, geometry, l, self.technique, &settings, into)?;
-            let depth = DepthCalls::of(geometry, &p);
+            let (depth, depth_args) = DepthCalls::of(geometry, &p);
             let first = args.len();
-            args.extend(depth.args.iter().cloned());
+            args.extend(depth_args);
+            // the sample's visibility pass follows its depth draws
+            let visibility_call = args.len();
             args.push(gpu::Indirect::draw(0..3));
-            prepared.push((p, depth, first));
+            prepared.push((p, depth, first, visibility_call));
         }
         let resolve_call = args.len();
         if scratch.accumulator.is_some() {
@@ -226,11 +228,10 @@ impl ShadowTechnique for MapTechnique {
         }
         let calls = gpu::Calls::new(gpu, encoder, gate, args);
         let stats = receivers.on_gpu.as_ref();
-        for (k, (l, (p, depth, first))) in lights.iter().zip(prepared).enumerate() {
+        for (k, (l, (p, depth, first, visibility_call))) in lights.iter().zip(prepared).enumerate() {
             // one map texture for all of them: the passes run in the order recorded
-            let visibility_call = first + depth.args.len();
             let lit = (l, &settings, stats);
-            let map = shared.mapper.record_prepared(gpu, encoder, geometry, p, lit, (&depth, &calls, first));
+            let map = shared.mapper.record_prepared(gpu, encoder, geometry, p, lit, (depth, &calls, first));
             primitives += u64::from(map.triangles_drawn());
             let out = match &scratch.accumulator {
                 Some(a) => VisibilityTarget::Add(a, k == 0),
