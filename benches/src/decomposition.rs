@@ -154,7 +154,7 @@ impl Frame {
         self.scene.objects[object].mesh.positions = moved;
         self.scene_box = scene_bounds(&self.scene);
         self.geometry.update_object(gpu, &self.scene, object)?;
-        self.wedges.update_object(&self.scene, object)?;
+        self.wedges.update_object(gpu, &self.scene, object)?;
         self.maps.update_object(gpu, &self.scene, object)
     }
 

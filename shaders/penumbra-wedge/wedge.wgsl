@@ -1,4 +1,4 @@
-// requires: penumbra-wedge/light.wgsl penumbra-wedge/coverage.wgsl
+// requires: penumbra-wedge/light.wgsl penumbra-wedge/coverage.wgsl penumbra-wedge/footprint.wgsl
 // Penumbra wedges: per pixel of a footprint (the conservative hull of a few consecutive
 // silhouette edges' wedges), each edge's signed coverage of the light's disk seen from the
 // G-buffer point, a_e / pi (coverage.wgsl), summed and added to the accumulator's g.
@@ -21,6 +21,26 @@ fn vs(@location(0) ndc: vec2<f32>, @location(1) first: u32, @location(2) count: 
     out.clip = vec4<f32>(ndc, 0.5, 1.0);
     out.first = first;
     out.count = count;
+    return out;
+}
+
+// Footprints built on the GPU (footprint.wgsl, one instance each): a fan of up to 18
+// triangles over its corners; triangles past them collapse to a point.
+@group(0) @binding(4) var<storage, read> footprints: array<Footprint>;
+
+@vertex
+fn vs_polygon(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> VsOut {
+    let f = footprints[instance];
+    let t = vertex / 3u;
+    let k = vertex % 3u;
+    var out: VsOut;
+    out.first = f.first;
+    out.count = f.edges;
+    if t + 2u >= f.count {
+        out.clip = vec4<f32>(0.0, 0.0, 0.5, 1.0);
+        return out;
+    }
+    out.clip = vec4<f32>(f.corners[select(t + k, 0u, k == 0u)], 0.5, 1.0);
     return out;
 }
 

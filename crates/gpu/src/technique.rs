@@ -226,6 +226,17 @@ pub trait ShadowTechnique {
         target: &wgpu::TextureView,
     ) -> Result<ShadowPassReport, GpuError>;
 
+    /// Completes the reports of the lights this technique recorded last (`reports` in record
+    /// order, skipped lights passed over) with what only the GPU knew when they were recorded,
+    /// e.g. the primitives and culled work of geometry built on the GPU. Measurement only: it
+    /// reads back and waits. The default has nothing to add.
+    ///
+    /// # Errors
+    /// GPU failures.
+    fn read_counts(&self, _gpu: &Gpu, _reports: &mut [ShadowPassReport]) -> Result<(), GpuError> {
+        Ok(())
+    }
+
     /// [`ShadowTechnique::record`] in a submission of its own, waited for and timed: what
     /// validate, the trade and the benches measure one light with.
     ///
@@ -242,7 +253,10 @@ pub trait ShadowTechnique {
         let (time, clock) =
             gpu.measure(|encoder| recorded = Some(self.record(gpu, encoder, receivers, light, None, target)))?;
         let report = recorded.ok_or_else(|| GpuError::Failed(format!("{}: nothing recorded", self.name())))??;
-        Ok(ShadowPassReport { time, clock: Some(clock), ..report })
+        let mut report = [ShadowPassReport { time, clock: Some(clock), ..report }];
+        self.read_counts(gpu, &mut report)?;
+        let [report] = report;
+        Ok(report)
     }
 }
 
@@ -379,6 +393,7 @@ pub fn render_visibility(
     encoder.resolve_query_set(&set, 0..queries, &resolve, 0);
     encoder.copy_buffer_to_buffer(&resolve, 0, &read, 0, bytes);
     gpu.submit_and_wait(encoder)?;
+    technique.read_counts(gpu, &mut reports)?;
     let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&crate::readback::read_mapped(gpu, &read)?);
     let period = f64::from(gpu.queue.get_timestamp_period());
     for k in timed {

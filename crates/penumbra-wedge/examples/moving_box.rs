@@ -343,7 +343,7 @@ pub fn run(map: Option<&Path>, out: &Path, frames: usize, (w, h): (u32, u32)) ->
         scene.objects[1].mesh.positions = rest.iter().map(|p| moved.transform_point3(*p)).collect();
         let first = meshes[0].positions.len() as u64 * std::mem::size_of::<Vertex>() as u64;
         queue.write_buffer(&vertex_buffer, first, bytemuck::cast_slice(&vertices_of(1, &scene.objects[1].mesh)));
-        wedges.update_object(&scene, 1)?;
+        wedges.update_object(&gpu, &scene, 1)?;
 
         // the renderer's G-buffer, and the toolkit's reduction of it, in one submission
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gbuffer") });

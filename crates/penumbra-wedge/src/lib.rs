@@ -26,12 +26,14 @@
 pub mod casters;
 pub mod coverage;
 pub mod geometry;
+mod gpu_build;
 
 use casters::{Caster, Casters};
 use geometry::reach_along;
 use glam::{Mat4, Vec3};
 use gpu::accumulate::{Accumulator, ResolvePass};
 use gpu::{Calls, Gpu, GpuError, Indirect, LightShape, Receivers, ShadowPassReport, ShadowTechnique};
+use gpu_build::{GpuBuilder, LightBuild};
 use std::cell::RefCell;
 use wgpu::util::DeviceExt;
 
@@ -45,6 +47,21 @@ pub enum WedgePath {
     /// its tile's edges in one compute invocation (`shaders/penumbra-wedge/tiles.wgsl`): no
     /// blending, one write per pixel, more edge terms evaluated (the whole tile's).
     Compute,
+}
+
+/// Where a light's silhouette, volume and footprints are built.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum WedgeBuild {
+    /// On the GPU, in compute passes recorded with the light (`shaders/penumbra-wedge/build.wgsl`):
+    /// the CPU never sees the silhouette. A footprint (an octagon around the wedges) covers
+    /// [`WedgeSettings::edges_per_footprint`] consecutive silhouette edges in the casters' edge
+    /// order (along a Morton curve) rather than along a chain. The raster path only: the
+    /// compute path bins footprints on the CPU and builds there.
+    #[default]
+    Gpu,
+    /// On the CPU ([`Wedges::plan`]), uploaded per light: the reference the GPU builder is
+    /// tested against, and the compute path's builder.
+    Cpu,
 }
 
 /// Knobs of the wedges.
@@ -61,12 +78,21 @@ pub struct WedgeSettings {
     /// Weight the light's disk by the receiver's cosine (`coverage` module doc), as a
     /// Lambertian receiver does; off: the plain covered fraction, paper 000's.
     pub cosine_weighted: bool,
+    /// Where the geometry is built (the raster path; the compute path builds on the CPU).
+    pub build: WedgeBuild,
 }
 
 impl Default for WedgeSettings {
-    /// Culling on, 8 edges per footprint, the raster path, cosine weighting.
+    /// Culling on, 8 edges per footprint (the CPU builder's), the raster path, cosine
+    /// weighting, built on the GPU.
     fn default() -> Self {
-        Self { cull: true, edges_per_footprint: 8, path: WedgePath::Raster, cosine_weighted: true }
+        Self {
+            cull: true,
+            edges_per_footprint: 8,
+            path: WedgePath::Raster,
+            cosine_weighted: true,
+            build: WedgeBuild::Gpu,
+        }
     }
 }
 
@@ -154,6 +180,9 @@ pub struct Wedges {
     resolve: ResolvePass,
     // the resolve's edge sum where the raster path leaves it in the accumulator
     no_edge_sum: wgpu::Texture,
+    // the GPU builder and the pipeline drawing its footprints
+    builder: GpuBuilder,
+    polygons: wgpu::RenderPipeline,
     // screen-sized targets reused from light to light (passes recorded in order), per size
     scratch: RefCell<Option<Scratch>>,
 }
@@ -171,6 +200,7 @@ struct Scratch {
 const LIBRARY: &[(&str, &str)] = &[
     ("penumbra-wedge/light.wgsl", include_str!("../../../shaders/penumbra-wedge/light.wgsl")),
     ("penumbra-wedge/coverage.wgsl", include_str!("../../../shaders/penumbra-wedge/coverage.wgsl")),
+    ("penumbra-wedge/footprint.wgsl", include_str!("../../../shaders/penumbra-wedge/footprint.wgsl")),
 ];
 
 #[repr(C)]
@@ -271,15 +301,15 @@ impl Wedges {
         let module = |label, src| gpu::shader::module(&gpu.device, label, src, LIBRARY);
         let volume_module = module("shadow volume", include_str!("../../../shaders/penumbra-wedge/volume.wgsl"));
         let wedge_module = module("wedges", include_str!("../../../shaders/penumbra-wedge/wedge.wgsl"));
-        let pipeline = |label, m: &wgpu::ShaderModule, layout: wgpu::VertexBufferLayout<'_>| {
+        let pipeline = |label, m: &wgpu::ShaderModule, entry: &str, layout: Option<wgpu::VertexBufferLayout<'_>>| {
             gpu.render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(label),
                 layout: None,
                 vertex: wgpu::VertexState {
                     module: m,
-                    entry_point: Some("vs"),
+                    entry_point: Some(entry),
                     compilation_options: Default::default(),
-                    buffers: &[Some(layout)],
+                    buffers: if layout.is_some() { std::slice::from_ref(&layout) } else { &[] },
                 },
                 // both windings: the volume's count needs them; footprints are screen-facing
                 primitive: wgpu::PrimitiveState::default(),
@@ -298,21 +328,24 @@ impl Wedges {
         let volume = pipeline(
             "shadow volume",
             &volume_module,
-            wgpu::VertexBufferLayout {
+            "vs",
+            Some(wgpu::VertexBufferLayout {
                 array_stride: 12,
                 step_mode: wgpu::VertexStepMode::Vertex,
                 attributes: &wgpu::vertex_attr_array![0 => Float32x3],
-            },
+            }),
         );
         let wedge = pipeline(
             "wedges",
             &wedge_module,
-            wgpu::VertexBufferLayout {
+            "vs",
+            Some(wgpu::VertexBufferLayout {
                 array_stride: std::mem::size_of::<FootprintVertex>() as u64,
                 step_mode: wgpu::VertexStepMode::Vertex,
                 attributes: &wgpu::vertex_attr_array![0 => Float32x2, 1 => Uint32, 2 => Uint32],
-            },
+            }),
         );
+        let polygons = pipeline("wedges built on the GPU", &wedge_module, "vs_polygon", None);
         let resolve = ResolvePass::with_shader(
             gpu,
             "wedge resolve",
@@ -329,6 +362,7 @@ impl Wedges {
             cache: None,
         });
         let no_edge_sum = edge_sum_texture(gpu, (1, 1));
+        let builder = GpuBuilder::new(gpu, &casters, settings.edges_per_footprint, LIBRARY);
         Self {
             casters,
             bounds: (lo, hi),
@@ -338,8 +372,22 @@ impl Wedges {
             tiles,
             resolve,
             no_edge_sum,
+            builder,
+            polygons,
             scratch: RefCell::new(None),
         }
+    }
+
+    /// The volume pass's bind group: the view, the G-buffer's positions.
+    fn volume_bind(&self, gpu: &Gpu, view: &wgpu::Buffer, position: &wgpu::TextureView) -> wgpu::BindGroup {
+        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("shadow volume"),
+            layout: &self.volume.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: view.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(position) },
+            ],
+        })
     }
 
     /// The scratch targets for images of `size`, made when the size changes.
@@ -355,16 +403,19 @@ impl Wedges {
     }
 
     /// Moves object `object` to its mesh in `scene` (a new pose): its caster is welded again
-    /// from the moved positions, on the CPU, as [`Wedges::new`] would; no GPU object is made.
+    /// from the moved positions, on the CPU, as [`Wedges::new`] would, and its positions are
+    /// written to the GPU builder's buffer (`queue.write_buffer`; its buffers are made again
+    /// only when the mesh's triangles changed). No pipeline is made.
     ///
     /// # Errors
     /// [`GpuError::Failed`] for an object out of range.
-    pub fn update_object(&mut self, scene: &scene::Scene, object: usize) -> Result<(), GpuError> {
+    pub fn update_object(&mut self, gpu: &Gpu, scene: &scene::Scene, object: usize) -> Result<(), GpuError> {
         let (Some(slot), Some(o)) = (self.casters.casters.get_mut(object), scene.objects.get(object)) else {
             return Err(GpuError::Failed(format!("wedges: no object {object}")));
         };
         *slot = Caster::new(&o.name, &o.mesh.positions, &o.mesh.indices);
         self.bounds = casters_bounds(&self.casters);
+        self.builder.update(gpu, &self.casters, object, self.settings.edges_per_footprint);
         Ok(())
     }
 
@@ -450,12 +501,232 @@ impl Wedges {
                 }
             }
         }
-        plan.culled = vec![
-            ("casters whose shadow cannot reach a visible receiver", casters_culled),
-            ("wedges off screen or away from visible receivers", away),
-            ("edges with an endpoint inside the light", at_light),
-        ];
+        plan.culled = vec![(CULLED_CASTERS, casters_culled), (CULLED_WEDGES, away), (CULLED_AT_LIGHT, at_light)];
         plan
+    }
+}
+
+/// What [`ShadowPassReport::culled`] counts, as [`Wedges::plan`] and the GPU builder name it.
+const CULLED_CASTERS: &str = "casters whose shadow cannot reach a visible receiver";
+const CULLED_WEDGES: &str = "wedges off screen or away from visible receivers";
+const CULLED_AT_LIGHT: &str = "edges with an endpoint inside the light";
+
+/// The light as light.wgsl's `Light` reads it.
+fn light_uniform(light: &LightShape, cosine_weighted: bool) -> [[f32; 4]; 2] {
+    let cosine = if cosine_weighted { 1.0 } else { 0.0 };
+    match *light {
+        LightShape::Distant { direction, half_angle } => {
+            [direction.normalize_or(Vec3::Y).extend(0.0).to_array(), [0.0, half_angle, cosine, 0.0]]
+        }
+        LightShape::Sphere { center, radius } => [center.extend(1.0).to_array(), [1.0, radius, cosine, 0.0]],
+    }
+}
+
+/// build.wgsl's `Build`.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct BuildUniform {
+    light: [[f32; 4]; 2],
+    view_proj: [[f32; 4]; 4],
+    receivers_lo: [f32; 4],
+    receivers_hi: [f32; 4],
+    reach: [f32; 4],
+    counts: [u32; 4],
+}
+
+impl Wedges {
+    /// Per caster, for `light` and the receivers' box: whether its shadow can reach a visible
+    /// receiver, whether it is closed, how far its volume reaches (as [`Wedges::plan`] decides),
+    /// and how many were culled.
+    fn caster_params(&self, light: &LightShape, rb: (Vec3, Vec3), extent: f32) -> (Vec<gpu_build::CasterParams>, u64) {
+        let cull = self.settings.cull;
+        let mut culled = 0u64;
+        let params = self
+            .casters
+            .casters
+            .iter()
+            .map(|c| {
+                let keep = !cull || shadow_can_reach(c, light, rb, extent);
+                culled += u64::from(!keep);
+                let length = match *light {
+                    LightShape::Distant { direction, .. } if cull => {
+                        let (centre, r) = c.bounds;
+                        reach_along(centre, r, -direction.normalize_or(Vec3::Y), 0.0, rb, extent)
+                            .unwrap_or(0.0)
+                            .max(r * 1e-3)
+                            + r
+                    }
+                    _ => extent,
+                };
+                [f32::from(u8::from(keep)), f32::from(u8::from(c.closed)), length, 0.0]
+            })
+            .collect();
+        (params, culled)
+    }
+
+    /// The silhouette the GPU builder finds for `light` and `receivers` (with these settings'
+    /// culling): its edges and their faces' normals, in the builder's order (by caster, then
+    /// welded vertex pair), without lit faces. Measurement and tests: it records the light's
+    /// passes, submits, waits and reads back.
+    ///
+    /// # Errors
+    /// Casters beyond the device's limits; GPU failures.
+    pub fn silhouette_on_gpu(
+        &self,
+        gpu: &Gpu,
+        receivers: &Receivers,
+        light: &LightShape,
+    ) -> Result<casters::Silhouette, GpuError> {
+        let mesh = self.builder.mesh.as_ref().map_err(|e| GpuError::Failed(format!("wedges: {e}")))?;
+        let (w, h) = receivers.gbuffer.size();
+        let vis = gpu::Visibility::new(gpu, w, h, 1)?;
+        let mut encoder = gpu.encoder("wedge silhouette");
+        self.record_built(gpu, &mut encoder, receivers, light, None, &vis.layer(0))?;
+        gpu.submit_and_wait(encoder)?;
+        let args: Vec<u32> = bytemuck::pod_collect_to_vec(&gpu::read_buffer(gpu, &mesh.args)?);
+        let edges: Vec<[[f32; 4]; 4]> = bytemuck::pod_collect_to_vec(&gpu::read_buffer(gpu, &mesh.silhouette)?);
+        let n = (args[12] as usize).min(edges.len());
+        let v = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
+        Ok(casters::Silhouette {
+            edges: edges[..n].iter().map(|e| [v(e[0]), v(e[1])]).collect(),
+            normals: edges[..n].iter().map(|e| [v(e[2]), v(e[3])]).collect(),
+            lit_faces: Vec::new(),
+        })
+    }
+
+    /// [`ShadowTechnique::record`] with the geometry built on the GPU (`gpu_build`).
+    fn record_built(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        receivers: &Receivers,
+        light: &LightShape,
+        gate: Option<gpu::Gate<'_>>,
+        target: &wgpu::TextureView,
+    ) -> Result<ShadowPassReport, GpuError> {
+        let mesh = self.builder.mesh.as_ref().map_err(|e| GpuError::Failed(format!("wedges: {e}")))?;
+        let gb = receivers.gbuffer;
+        let extent = self.extent(receivers.bounds);
+        let view_proj = gb.view.unclipped_projection(extent * 1e-6);
+        let (params, culled, counts) = match receivers.bounds {
+            Some(rb) => {
+                let (p, culled) = self.caster_params(light, rb, extent);
+                (p, culled, GpuBuilder::counts_row(mesh))
+            }
+            // nothing visible: nothing to build
+            None => (Vec::new(), 0, [0; 4]),
+        };
+        let (lo, hi) = receivers.bounds.unwrap_or((Vec3::ZERO, Vec3::ZERO));
+        let light_params = light_uniform(light, self.settings.cosine_weighted);
+        let uniform = BuildUniform {
+            light: light_params,
+            view_proj: view_proj.to_cols_array_2d(),
+            receivers_lo: lo.extend(0.0).to_array(),
+            receivers_hi: hi.extend(0.0).to_array(),
+            reach: [
+                extent,
+                extent * 1e-7,
+                f32::from(u8::from(self.settings.cull)),
+                gpu_build::group_size(self.settings.edges_per_footprint) as f32,
+            ],
+            counts,
+        };
+        let device = &gpu.device;
+        let buffer = |label, contents: &[u8], usage| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+        };
+        let mut caster_words = params;
+        if caster_words.is_empty() {
+            caster_words.push([0.0; 4]);
+        }
+        let uniform_buf = buffer("wedge build", bytemuck::bytes_of(&uniform), wgpu::BufferUsages::UNIFORM);
+        let casters_buf = buffer("wedge casters", bytemuck::cast_slice(&caster_words), wgpu::BufferUsages::STORAGE);
+        let light_buf = buffer("wedge light", bytemuck::cast_slice(&light_params), wgpu::BufferUsages::UNIFORM);
+        let view = view_uniform(&gb.view, &view_proj, receivers.bounds, extent);
+        let view_buf = buffer("wedge view", bytemuck::bytes_of(&view), wgpu::BufferUsages::UNIFORM);
+        let binds = self.builder.bind_groups(gpu, mesh, &LightBuild { uniform: &uniform_buf, casters: &casters_buf });
+        let position = gb.position.create_view(&Default::default());
+        let normal = gb.geometric_normal.create_view(&Default::default());
+        let volume_bind = self.volume_bind(gpu, &view_buf, &position);
+        let wedge_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("wedges"),
+            layout: &self.polygons.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: light_buf.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: mesh.silhouette.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&position) },
+                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&normal) },
+                wgpu::BindGroupEntry { binding: 4, resource: mesh.footprints.as_entire_binding() },
+            ],
+        });
+        let scratch = self.scratch(gpu, gb.size())?;
+        let acc = &scratch.accumulator;
+        // what the GPU does not write stays zero: no draw, no dispatch
+        encoder.clear_buffer(&mesh.args, 0, None);
+        encoder.clear_buffer(&mesh.footprint_dispatch, 0, None);
+        let (faces, edges) = if counts[0] == 0 && counts[1] == 0 { (0, 0) } else { GpuBuilder::groups(mesh) };
+        let calls = Calls::new(
+            gpu,
+            encoder,
+            gate,
+            vec![
+                Indirect::Dispatch([faces, 1, 1]),
+                Indirect::Dispatch([edges, 1, 1]),
+                Indirect::Dispatch([u32::from(edges > 0), 1, 1]),
+                Indirect::Dispatch([edges, 1, 1]),
+                Indirect::draw(0..3),
+            ],
+        );
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("wedge build"),
+                timestamp_writes: None,
+            });
+            let stages = [&self.builder.classify, &self.builder.mark, &self.builder.scan, &self.builder.emit];
+            for (k, (pipeline, bind)) in stages.into_iter().zip(&binds).enumerate() {
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, bind, &[]);
+                calls.dispatch(&mut pass, k);
+            }
+            pass.set_pipeline(&self.builder.footprint);
+            pass.set_bind_group(0, &binds[4], &[]);
+            pass.dispatch_workgroups_indirect(&mesh.footprint_dispatch, 0);
+        }
+        {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("wedges"),
+                color_attachments: &[Some(acc.attachment(true))],
+                ..Default::default()
+            });
+            pass.set_pipeline(&self.volume);
+            pass.set_bind_group(0, &volume_bind, &[]);
+            pass.set_vertex_buffer(0, mesh.volume.slice(..));
+            pass.draw_indirect(&mesh.args, 0);
+            pass.set_pipeline(&self.polygons);
+            pass.set_bind_group(0, &wedge_bind, &[]);
+            pass.draw_indirect(&mesh.args, 16);
+        }
+        self.builder.keep_counts(encoder, mesh);
+        let sum = self.no_edge_sum.create_view(&Default::default());
+        let extra = [(3, wgpu::BindingResource::TextureView(&normal)), (4, wgpu::BindingResource::TextureView(&sum))];
+        self.resolve.record(
+            gpu,
+            encoder,
+            gb,
+            acc,
+            bytemuck::cast_slice(&light_params),
+            &extra,
+            Some((&calls, 4)),
+            target,
+        );
+        Ok(ShadowPassReport {
+            time: std::time::Duration::ZERO,
+            clock: None,
+            skipped: None,
+            // known once the frame has run (`read_counts`)
+            primitives: 0,
+            culled: if receivers.bounds.is_some() { vec![(CULLED_CASTERS, culled)] } else { Vec::new() },
+        })
     }
 }
 
@@ -469,11 +740,34 @@ impl ShadowTechnique for Wedges {
             "wedges{path}{}{}",
             if self.settings.cull { "" } else { "_unculled" },
             if self.settings.cosine_weighted { "" } else { "_unweighted" }
-        )
+        ) + if self.settings.build == WedgeBuild::Cpu && self.settings.path == WedgePath::Raster {
+            "_cpu_built"
+        } else {
+            ""
+        }
     }
 
     fn supports(&self, _light: &LightShape) -> bool {
         true
+    }
+
+    /// The GPU builder's counts: primitives drawn (volume and footprint triangles), wedges off
+    /// screen or away from receivers, edges with an endpoint inside the light.
+    fn read_counts(&self, gpu: &Gpu, reports: &mut [ShadowPassReport]) -> Result<(), GpuError> {
+        if self.settings.build != WedgeBuild::Gpu || self.settings.path != WedgePath::Raster {
+            return Ok(());
+        }
+        let shadowed: Vec<&mut ShadowPassReport> = reports.iter_mut().filter(|r| r.skipped.is_none()).collect();
+        let counts = self.builder.read_counts(gpu, shadowed.len())?;
+        // the last lights recorded are the last reports
+        for (r, c) in shadowed.into_iter().rev().zip(counts.into_iter().rev()) {
+            r.primitives = u64::from(c[0] / 3) + u64::from(c[15]);
+            if !r.culled.is_empty() {
+                r.culled.push((CULLED_WEDGES, c[13].into()));
+                r.culled.push((CULLED_AT_LIGHT, c[14].into()));
+            }
+        }
+        Ok(())
     }
 
     fn record(
@@ -485,6 +779,9 @@ impl ShadowTechnique for Wedges {
         gate: Option<gpu::Gate<'_>>,
         target: &wgpu::TextureView,
     ) -> Result<ShadowPassReport, GpuError> {
+        if self.settings.build == WedgeBuild::Gpu && self.settings.path == WedgePath::Raster {
+            return self.record_built(gpu, encoder, receivers, light, gate, target);
+        }
         let gb = receivers.gbuffer;
         let extent = self.extent(receivers.bounds);
         let view_proj = gb.view.unclipped_projection(extent * 1e-6);
@@ -511,13 +808,7 @@ impl ShadowTechnique for Wedges {
         let buffer = |label, contents: &[u8], usage| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
         };
-        let cosine = if self.settings.cosine_weighted { 1.0 } else { 0.0 };
-        let light_params: [[f32; 4]; 2] = match *light {
-            LightShape::Distant { direction, half_angle } => {
-                [direction.normalize_or(Vec3::Y).extend(0.0).to_array(), [0.0, half_angle, cosine, 0.0]]
-            }
-            LightShape::Sphere { center, radius } => [center.extend(1.0).to_array(), [1.0, radius, cosine, 0.0]],
-        };
+        let light_params = light_uniform(light, self.settings.cosine_weighted);
         let view = view_uniform(&gb.view, &view_proj, receivers.bounds, extent);
         let view_buf = buffer("wedge view", bytemuck::bytes_of(&view), wgpu::BufferUsages::UNIFORM);
         let light_buf = buffer("wedge light", bytemuck::cast_slice(&light_params), wgpu::BufferUsages::UNIFORM);
@@ -530,14 +821,7 @@ impl ShadowTechnique for Wedges {
             .then(|| buffer("wedge footprints", bytemuck::cast_slice(&footprints), wgpu::BufferUsages::VERTEX));
         let position = gb.position.create_view(&Default::default());
         let normal = gb.geometric_normal.create_view(&Default::default());
-        let volume_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("shadow volume"),
-            layout: &self.volume.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: view_buf.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&position) },
-            ],
-        });
+        let volume_bind = self.volume_bind(gpu, &view_buf, &position);
         let wedge_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("wedges"),
             layout: &self.wedge.get_bind_group_layout(0),

@@ -93,13 +93,13 @@ fn a_moved_caster_shadows_as_wedges_built_for_its_pose() {
     let mut updated = Wedges::new(&gpu, &rest, WedgeSettings::default());
     let at_rest = recorded(&gpu, &updated, &receivers, &lights).0;
     let before = gpu.counters();
-    updated.update_object(&moved, object).unwrap();
+    updated.update_object(&gpu, &moved, object).unwrap();
     assert_eq!(gpu.counters() - before, gpu::GpuCounters::default(), "moving made GPU work");
     let fresh = Wedges::new(&gpu, &moved, WedgeSettings::default());
     let (a, b) = (recorded(&gpu, &updated, &receivers, &lights).0, recorded(&gpu, &fresh, &receivers, &lights).0);
     assert!(a == b, "the updated wedges differ from wedges built for the pose");
     assert!(a != at_rest, "the shadows did not move with the caster");
-    assert!(updated.update_object(&moved, moved.objects.len()).is_err());
+    assert!(updated.update_object(&gpu, &moved, moved.objects.len()).is_err());
 }
 
 #[test]

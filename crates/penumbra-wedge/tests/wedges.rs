@@ -7,7 +7,7 @@
 
 use glam::Vec3;
 use gpu::{GBufferPass, Gpu, LightShape, Receivers, SceneGeometry, ShadowTechnique, Visibility};
-use penumbra_wedge::{WedgePath, WedgeSettings, Wedges, coverage};
+use penumbra_wedge::{WedgeBuild, WedgePath, WedgeSettings, Wedges, coverage};
 use ref_tracer::SceneBvh;
 use ref_tracer::visibility::{AreaLight, VisibilityLight, Weighting, area_light_visibility, light_visibility};
 use scene::Scene;
@@ -286,14 +286,17 @@ fn overlapping_casters_are_counted_twice_where_both_cover_the_light() {
     assert!(mirror < 0.002, "GPU against its CPU mirror: {mirror}");
 }
 
-/// The tiled compute path writes what the raster path writes: the same edge terms, summed per
-/// pixel over its tile's footprints instead of per rasterized footprint (R8Unorm layers: equal
-/// to a unit in the last place where float sums round differently), for distant lights small
-/// and huge, a local light, culled or not, the camera inside a volume, and one edge per
-/// footprint. (The camera-in-a-volume case found raster footprints losing the screen's top row
-/// to rounding when clipped at the eye's plane; `geometry::SCREEN_MARGIN` is the fix.)
+/// The three builders and paths write the same visibility: the raster path with its geometry
+/// built on the GPU (the default), the raster path built on the CPU (`Wedges::plan`, the
+/// reference) and the tiled compute path (built on the CPU, edge terms summed per pixel over
+/// its tile's footprints). The same edge terms everywhere, summed in other orders (R8Unorm
+/// layers: equal to a unit in the last place where float sums round differently), with the
+/// same culled work counted, for distant lights small and huge, a local light, culled or not,
+/// the camera inside a volume, and one edge per footprint. (The camera-in-a-volume case found
+/// raster footprints losing the screen's top row to rounding when clipped at the eye's plane;
+/// `geometry::SCREEN_MARGIN` is the fix.)
 #[test]
-fn compute_path_writes_the_raster_paths_visibility() {
+fn every_builder_and_path_writes_the_same_visibility() {
     let local = LightShape::Sphere { center: Vec3::new(0.5, 3.0, 1.0), radius: 0.3 };
     // the eye in the middle box's shadow (camera_inside_a_shadow_volume's setting)
     let mut inside = scene("three_boxes", 160, 120);
@@ -307,14 +310,22 @@ fn compute_path_writes_the_raster_paths_visibility() {
         ("camera in a volume", inside, across, 8, true),
     ];
     for (what, s, light, edges_per_footprint, cull) in cases {
-        let settings = |path| WedgeSettings { cull, edges_per_footprint, path, cosine_weighted: true };
-        let raster = render_with(s.clone(), light, settings(WedgePath::Raster));
-        let compute = render_with(s, light, settings(WedgePath::Compute));
-        let soft = raster.wedges.iter().filter(|v| **v > 0.02 && **v < 0.98).count();
+        let settings = |path, build| WedgeSettings { cull, edges_per_footprint, path, cosine_weighted: true, build };
+        let built = render_with(s.clone(), light, settings(WedgePath::Raster, WedgeBuild::Gpu));
+        let planned = render_with(s.clone(), light, settings(WedgePath::Raster, WedgeBuild::Cpu));
+        let compute = render_with(s, light, settings(WedgePath::Compute, WedgeBuild::Gpu));
+        let soft = planned.wedges.iter().filter(|v| **v > 0.02 && **v < 0.98).count();
         assert!(soft > 20, "{what}: {soft} penumbra pixels");
-        let worst = raster.wedges.iter().zip(&compute.wedges).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
-        assert!(worst <= 1.5 / 255.0, "{what}: layers differ by up to {worst}");
-        assert_eq!(raster.report.culled, compute.report.culled, "{what}");
+        for (name, other) in [("built on the GPU", &built), ("compute", &compute)] {
+            let worst = planned.wedges.iter().zip(&other.wedges).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+            assert!(worst <= 1.5 / 255.0, "{what}: {name} differs from the CPU-built raster by up to {worst}");
+        }
+        assert_eq!(planned.report.culled, compute.report.culled, "{what}");
+        // the GPU builder culls wedges one edge at a time (the CPU a footprint's group), so only
+        // the casters and the edges at the light count alike
+        let (cpu, gpu) = (&planned.report.culled, &built.report.culled);
+        assert_eq!((cpu.len(), cpu[0], cpu[2]), (gpu.len(), gpu[0], gpu[2]), "{what}");
+        assert!(built.report.primitives > 0, "{what}");
     }
 }
 
@@ -487,4 +498,69 @@ fn a_gbuffer_made_from_depth_shadows_as_the_rasterized_one() {
     let (mean, _, bad, soft) = compare(&a, &b, 0.02);
     assert!(soft > 100, "{soft} penumbra pixels");
     assert!(mean < 1e-3 && bad < 0.005, "mean {mean}, {:.2} % of pixels off by > 0.02", bad * 100.0);
+}
+
+/// The silhouette the GPU builder finds is the CPU builder's (`Casters::silhouette`, the
+/// reference): the same oriented edges, each as often (a sheet folded on itself winds an edge
+/// twice), with the same faces' normals, for closed meshes, sheets lit from either side, a
+/// non-manifold fan of three faces on one edge and a fold, distant lights from above, below
+/// and the horizon, and local lights in and out of the casters' bounds.
+#[test]
+fn gpu_silhouettes_are_the_cpu_builders() {
+    let mut odd = scene("three_boxes", 96, 72);
+    // a fan: three faces on the edge (0, 1); a fold: two faces wound alike on (3, 4)
+    let (a, b) = (Vec3::new(-1.5, 1.2, 0.0), Vec3::new(-1.5, 1.2, 1.0));
+    let fan = scene::Mesh {
+        positions: vec![a, b, Vec3::new(-2.2, 1.0, 0.5), Vec3::new(-1.0, 1.9, 0.5), Vec3::new(-0.9, 0.8, 0.4)],
+        normals: None,
+        indices: vec![[0, 1, 2], [0, 1, 3], [1, 0, 4]],
+    };
+    let (c, d) = (Vec3::new(1.4, 1.0, -0.5), Vec3::new(1.9, 1.0, -0.5));
+    let fold = scene::Mesh {
+        positions: vec![c, d, Vec3::new(1.6, 1.3, 0.2), Vec3::new(1.7, 1.4, -1.1)],
+        normals: None,
+        indices: vec![[0, 1, 2], [0, 1, 3]],
+    };
+    for (name, mesh) in [("fan", fan), ("fold", fold)] {
+        odd.objects.push(scene::Object { name: name.into(), mesh, material: scene::Material::lambert(0.5) });
+    }
+    let lights = [
+        sun(4.0),
+        LightShape::Distant { direction: Vec3::new(0.2, -1.0, 0.3).normalize(), half_angle: 0.05 },
+        LightShape::Distant { direction: Vec3::new(1.0, 0.0, 0.2).normalize(), half_angle: 0.1 },
+        LightShape::Sphere { center: Vec3::new(0.5, 3.0, 1.0), radius: 0.3 },
+        LightShape::Sphere { center: Vec3::new(0.0, 0.4, 0.0), radius: 0.05 },
+    ];
+    let settings = WedgeSettings { cull: false, ..WedgeSettings::default() };
+    let key = |e: &[Vec3; 2]| e.map(|p| p.to_array().map(f32::to_bits));
+    let mut twice = false;
+    for s in [scene("spheres_box", 96, 72), scene("column", 96, 72), odd] {
+        let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
+        let geometry = SceneGeometry::upload(&gpu, &s).unwrap();
+        let gb = GBufferPass::new(&gpu).render(&gpu, &geometry, &s.camera).unwrap();
+        let points = gb.read_points(&gpu).unwrap();
+        let receivers = Receivers::new(&gb, &points);
+        let wedges = Wedges::new(&gpu, &s, settings);
+        for light in &lights {
+            let cpu = penumbra_wedge::casters::Casters::new(&s).silhouette(light, |_| true);
+            let gpu_sil = wedges.silhouette_on_gpu(&gpu, &receivers, light).unwrap();
+            assert!(!cpu.edges.is_empty(), "{light:?}");
+            let sorted = |sil: &penumbra_wedge::casters::Silhouette| {
+                let mut v: Vec<([[u32; 3]; 2], [Vec3; 2])> =
+                    sil.edges.iter().map(key).zip(sil.normals.iter().copied()).collect();
+                v.sort_by_key(|x| x.0);
+                v
+            };
+            let (want, got) = (sorted(&cpu), sorted(&gpu_sil));
+            assert_eq!(want.len(), got.len(), "{light:?}: silhouette edges");
+            twice |= want.windows(2).any(|w| w[0].0 == w[1].0);
+            for ((ke, ne), (kg, ng)) in want.iter().zip(&got) {
+                assert_eq!(ke, kg, "{light:?}: an edge differs");
+                for k in 0..2 {
+                    assert!(ne[k].distance(ng[k]) < 1e-5, "{light:?}: normals {ne:?} against {ng:?}");
+                }
+            }
+        }
+    }
+    assert!(twice, "no light saw the fold wind an edge twice");
 }
