@@ -12,7 +12,7 @@
 //   emit       per edge: |net| oriented silhouette edges at its offset, and the volume's side
 //              quads (appended; the volume's counts are integers, their order does not matter).
 //   footprints per group of consecutive silhouette edges (the casters' edges are sorted along
-//              a Morton curve, so consecutive ones lie near each other): each edge's 18 wedge
+//              a Hilbert curve, so consecutive ones lie near each other): each edge's 18 wedge
 //              hull points, projected and clipped at the near plane, bounded by one octagon
 //              (x, y and both diagonals) and clipped to the screen: a footprint that contains
 //              the wedges.

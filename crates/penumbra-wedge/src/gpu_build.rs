@@ -86,18 +86,40 @@ fn storage(gpu: &Gpu, label: &str, bytes: u64, extra: wgpu::BufferUsages) -> wgp
     })
 }
 
-/// The Morton code (21 bits an axis) of `p` in the cube of half-side `radius` about `centre`.
-fn morton(p: glam::Vec3, centre: glam::Vec3, radius: f32) -> u64 {
-    let spread = |v: f32| {
-        let mut x = (v.clamp(0.0, 1.0) * ((1 << 21) - 1) as f32) as u64;
-        x = (x | x << 32) & 0x1f_0000_0000_ffff;
-        x = (x | x << 16) & 0x1f_0000_ff00_00ff;
-        x = (x | x << 8) & 0x100f_00f0_0f00_f00f;
-        x = (x | x << 4) & 0x10c3_0c30_c30c_30c3;
-        (x | x << 2) & 0x1249_2492_4924_9249
-    };
+/// The index of `p` along a Hilbert curve (21 bits an axis) through the cube of half-side
+/// `radius` about `centre` (Skilling 2004, "Programming the Hilbert curve"): unlike a Morton
+/// curve it never jumps, so consecutive edges in its order lie next to each other.
+fn hilbert(p: glam::Vec3, centre: glam::Vec3, radius: f32) -> u64 {
+    const BITS: u32 = 21;
     let q = (p - centre) / (2.0 * radius.max(f32::MIN_POSITIVE)) + 0.5;
-    spread(q.x) | spread(q.y) << 1 | spread(q.z) << 2
+    let mut x = q.to_array().map(|v| (v.clamp(0.0, 1.0) * ((1u32 << BITS) - 1) as f32) as u32);
+    let top = 1u32 << (BITS - 1);
+    let mut bit = top;
+    while bit > 1 {
+        let low = bit - 1;
+        for i in 0..3 {
+            if x[i] & bit != 0 {
+                x[0] ^= low;
+            } else {
+                let t = (x[0] ^ x[i]) & low;
+                x[0] ^= t;
+                x[i] ^= t;
+            }
+        }
+        bit >>= 1;
+    }
+    x[1] ^= x[0];
+    x[2] ^= x[1];
+    let mut t = 0;
+    let mut bit = top;
+    while bit > 1 {
+        if x[2] & bit != 0 {
+            t ^= bit - 1;
+        }
+        bit >>= 1;
+    }
+    let x = x.map(|v| v ^ t);
+    (0..BITS).rev().fold(0u64, |h, b| (0..3).fold(h, |h, i| (h << 1) | u64::from((x[i] >> b) & 1)))
 }
 
 fn positions_of(casters: &Casters) -> Vec<[f32; 4]> {
@@ -124,7 +146,7 @@ impl MeshBuffers {
             }
             base += c.positions.len() as u32;
         }
-        // each caster's edges along a Morton curve of their midpoints in its bounds: the
+        // each caster's edges along a Hilbert curve of their midpoints in its bounds: the
         // silhouette keeps this order, so a footprint's consecutive edges lie near each other
         let positions = positions_of(casters);
         let at = |i: u32| glam::Vec4::from(positions[i as usize]).truncate();
@@ -133,7 +155,7 @@ impl MeshBuffers {
             .map(|&(lo, hi)| {
                 let caster = faces[adjacency[&(lo, hi)][0] as usize][3];
                 let (centre, radius) = casters.casters[caster as usize].bounds;
-                (caster, morton(0.5 * (at(lo) + at(hi)), centre, radius), (lo, hi))
+                (caster, hilbert(0.5 * (at(lo) + at(hi)), centre, radius), (lo, hi))
             })
             .collect();
         order.sort_unstable();
@@ -364,5 +386,35 @@ impl GpuBuilder {
                 w
             })
             .collect())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::hilbert;
+    use glam::Vec3;
+
+    /// On a 2^k grid, consecutive cells along the curve are face neighbours: every index
+    /// once, each step one cell along one axis.
+    #[test]
+    fn hilbert_order_visits_every_cell_by_unit_steps() {
+        let n = 8u32;
+        let cell = |i: u32| (i as f32 + 0.5) / n as f32 * 2.0 - 1.0;
+        let mut cells: Vec<(u64, [i32; 3])> = Vec::new();
+        for x in 0..n {
+            for y in 0..n {
+                for z in 0..n {
+                    let p = Vec3::new(cell(x), cell(y), cell(z));
+                    cells.push((hilbert(p, Vec3::ZERO, 1.0), [x as i32, y as i32, z as i32]));
+                }
+            }
+        }
+        cells.sort_unstable();
+        cells.dedup_by_key(|c| c.0);
+        assert_eq!(cells.len(), (n * n * n) as usize, "distinct indices");
+        for w in cells.windows(2) {
+            let d: i32 = (0..3).map(|k| (w[0].1[k] - w[1].1[k]).abs()).sum();
+            assert_eq!(d, 1, "{:?} to {:?}", w[0].1, w[1].1);
+        }
     }
 }

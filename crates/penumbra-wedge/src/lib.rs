@@ -55,7 +55,7 @@ pub enum WedgeBuild {
     /// On the GPU, in compute passes recorded with the light (`shaders/penumbra-wedge/build.wgsl`):
     /// the CPU never sees the silhouette. A footprint (an octagon around the wedges) covers
     /// [`WedgeSettings::edges_per_footprint`] consecutive silhouette edges in the casters' edge
-    /// order (along a Morton curve) rather than along a chain. The raster path only: the
+    /// order (along a Hilbert curve) rather than along a chain. The raster path only: the
     /// compute path bins footprints on the CPU and builds there.
     #[default]
     Gpu,
