@@ -18,7 +18,7 @@ use std::collections::BTreeMap;
 use wgpu::util::DeviceExt;
 
 /// Edges a workgroup of `mark` and `emit` handles (build.wgsl's workgroup size).
-const BLOCK: u32 = 256;
+pub(crate) const BLOCK: u32 = 256;
 /// Silhouette edges a workgroup of `footprint` handles.
 const FOOTPRINT_GROUP: u32 = 64;
 /// Bytes of build.wgsl's `Mark`.
@@ -52,8 +52,8 @@ pub(crate) struct MeshBuffers {
     pub(crate) face_count: u32,
     pub(crate) edge_count: u32,
     capacity: u32,
-    // per caster: its first welded vertex, its vertex count and the triangles it was built with
-    layout: Vec<(u32, u32, Vec<[u32; 3]>)>,
+    // per caster, its first welded vertex in `positions`
+    bases: Vec<u32>,
 }
 
 /// Silhouette edges a footprint: the setting, within 1 ..= 64.
@@ -129,12 +129,12 @@ fn positions_of(casters: &Casters) -> Vec<[f32; 4]> {
 impl MeshBuffers {
     fn new(gpu: &Gpu, casters: &Casters, edges_per_footprint: u32) -> Result<Self, GpuError> {
         let mut faces: Vec<[u32; 4]> = Vec::new();
-        let mut layout = Vec::with_capacity(casters.casters.len());
+        let mut bases = Vec::with_capacity(casters.casters.len());
         // per undirected edge (global welded indices), its faces in triangle order
         let mut adjacency: BTreeMap<(u32, u32), Vec<u32>> = BTreeMap::new();
         let mut base = 0u32;
         for (k, c) in casters.casters.iter().enumerate() {
-            layout.push((base, c.positions.len() as u32, c.triangles.clone()));
+            bases.push(base);
             for t in &c.triangles {
                 let g = t.map(|i| i + base);
                 let face = faces.len() as u32;
@@ -241,7 +241,7 @@ impl MeshBuffers {
             face_count: faces.len() as u32,
             edge_count: edges.len() as u32,
             capacity: capacity as u32,
-            layout,
+            bases,
         })
     }
 }
@@ -287,18 +287,25 @@ impl GpuBuilder {
         }
     }
 
-    /// Caster `object` moved: its positions are written where its triangles are the ones the
-    /// buffers were made with; otherwise (another mesh) the buffers are made again.
-    pub(crate) fn update(&mut self, gpu: &Gpu, casters: &Casters, object: usize, edges_per_footprint: u32) {
-        let caster = &casters.casters[object];
-        if let Ok(mesh) = &self.mesh
-            && let Some((base, count, triangles)) = mesh.layout.get(object)
-            && *count as usize == caster.positions.len()
-            && *triangles == caster.triangles
+    /// Caster `object` moved: with `same_triangles` (its welded triangles and vertex count are
+    /// the ones the buffers were made with) its positions are written; otherwise the buffers
+    /// are made again.
+    pub(crate) fn update(
+        &mut self,
+        gpu: &Gpu,
+        casters: &Casters,
+        object: usize,
+        same_triangles: bool,
+        edges_per_footprint: u32,
+    ) {
+        if same_triangles
+            && let Ok(mesh) = &self.mesh
+            && let Some(&base) = mesh.bases.get(object)
         {
-            let data: Vec<[f32; 4]> = caster.positions.iter().map(|p| p.extend(1.0).to_array()).collect();
+            let data: Vec<[f32; 4]> =
+                casters.casters[object].positions.iter().map(|p| p.extend(1.0).to_array()).collect();
             if !data.is_empty() {
-                gpu.queue.write_buffer(&mesh.positions, u64::from(*base) * 16, bytemuck::cast_slice(&data));
+                gpu.queue.write_buffer(&mesh.positions, u64::from(base) * 16, bytemuck::cast_slice(&data));
             }
             return;
         }
@@ -345,11 +352,6 @@ impl GpuBuilder {
             group(&self.emit, &[0, 1, 2, 7, 8, 9, 10, 11]),
             group(&self.footprint, &[0, 9, 11, 12, 14, 15]),
         ]
-    }
-
-    /// Workgroups of the per-face and per-edge dispatches.
-    pub(crate) fn groups(mesh: &MeshBuffers) -> (u32, u32) {
-        (mesh.face_count.div_ceil(BLOCK), mesh.edge_count.div_ceil(BLOCK))
     }
 
     /// The uniform's counts row: faces, edges, edge blocks, silhouette capacity.

@@ -413,9 +413,12 @@ impl Wedges {
         let (Some(slot), Some(o)) = (self.casters.casters.get_mut(object), scene.objects.get(object)) else {
             return Err(GpuError::Failed(format!("wedges: no object {object}")));
         };
-        *slot = Caster::new(&o.name, &o.mesh.positions, &o.mesh.indices);
+        let moved = Caster::new(&o.name, &o.mesh.positions, &o.mesh.indices);
+        // the same welded triangles: the builder's buffers hold its topology already
+        let same = moved.triangles == slot.triangles && moved.positions.len() == slot.positions.len();
+        *slot = moved;
         self.bounds = casters_bounds(&self.casters);
-        self.builder.update(gpu, &self.casters, object, self.settings.edges_per_footprint);
+        self.builder.update(gpu, &self.casters, object, same, self.settings.edges_per_footprint);
         Ok(())
     }
 
@@ -447,22 +450,13 @@ impl Wedges {
         let cull = self.settings.cull;
         let mut casters_culled = 0u64;
         let sils = self.casters.silhouettes(light, |c| {
-            let keep = !cull || shadow_can_reach(c, light, rb, extent);
+            let keep = self.casts(c, light, rb, extent);
             casters_culled += u64::from(!keep);
             keep
         });
         let (mut at_light, mut away) = (0u64, 0u64);
         for (caster, sil) in &sils {
-            // a distant light's volume ends where no receiver can be (from the caster's
-            // bounding sphere); local lights' volumes keep the scene's extent
-            let length = match *light {
-                LightShape::Distant { direction, .. } if cull => {
-                    let (c, r) = caster.bounds;
-                    reach_along(c, r, -direction.normalize_or(Vec3::Y), 0.0, rb, extent).unwrap_or(0.0).max(r * 1e-3)
-                        + r
-                }
-                _ => extent,
-            };
+            let length = self.volume_length(caster, light, rb, extent);
             plan.volume.extend(geometry::shadow_volume(sil, light, length));
             for chain in geometry::chains(&sil.edges) {
                 for group in chain.chunks(self.settings.edges_per_footprint.max(1) as usize) {
@@ -535,29 +529,36 @@ struct BuildUniform {
 }
 
 impl Wedges {
-    /// Per caster, for `light` and the receivers' box: whether its shadow can reach a visible
-    /// receiver, whether it is closed, how far its volume reaches (as [`Wedges::plan`] decides),
-    /// and how many were culled.
+    /// Whether `caster` casts for `light` with these settings: always unculled, else when its
+    /// shadow can reach the receivers' box `rb`.
+    fn casts(&self, caster: &Caster, light: &LightShape, rb: (Vec3, Vec3), extent: f32) -> bool {
+        !self.settings.cull || shadow_can_reach(caster, light, rb, extent)
+    }
+
+    /// How far `caster`'s volume reaches: a distant light's, culled, ends where no receiver can
+    /// be (from the caster's bounding sphere); otherwise the scene's extent.
+    fn volume_length(&self, caster: &Caster, light: &LightShape, rb: (Vec3, Vec3), extent: f32) -> f32 {
+        match *light {
+            LightShape::Distant { direction, .. } if self.settings.cull => {
+                let (c, r) = caster.bounds;
+                reach_along(c, r, -direction.normalize_or(Vec3::Y), 0.0, rb, extent).unwrap_or(0.0).max(r * 1e-3) + r
+            }
+            _ => extent,
+        }
+    }
+
+    /// Per caster, for `light` and the receivers' box, what the GPU builder reads (as
+    /// [`Wedges::plan`] decides it), and how many casters were culled.
     fn caster_params(&self, light: &LightShape, rb: (Vec3, Vec3), extent: f32) -> (Vec<gpu_build::CasterParams>, u64) {
-        let cull = self.settings.cull;
         let mut culled = 0u64;
         let params = self
             .casters
             .casters
             .iter()
             .map(|c| {
-                let keep = !cull || shadow_can_reach(c, light, rb, extent);
+                let keep = self.casts(c, light, rb, extent);
                 culled += u64::from(!keep);
-                let length = match *light {
-                    LightShape::Distant { direction, .. } if cull => {
-                        let (centre, r) = c.bounds;
-                        reach_along(centre, r, -direction.normalize_or(Vec3::Y), 0.0, rb, extent)
-                            .unwrap_or(0.0)
-                            .max(r * 1e-3)
-                            + r
-                    }
-                    _ => extent,
-                };
+                let length = self.volume_length(c, light, rb, extent);
                 [f32::from(u8::from(keep)), f32::from(u8::from(c.closed)), length, 0.0]
             })
             .collect();
@@ -566,23 +567,25 @@ impl Wedges {
 
     /// The silhouette the GPU builder finds for `light` and `receivers` (with these settings'
     /// culling): its edges and their faces' normals, in the builder's order (by caster, then
-    /// welded vertex pair), without lit faces. Measurement and tests: it records the light's
-    /// passes, submits, waits and reads back.
+    /// along its edges' curve), without lit faces. Measurement and tests: the light measured
+    /// ([`ShadowTechnique::write_visibility`]), then its silhouette read back.
     ///
     /// # Errors
-    /// Casters beyond the device's limits; GPU failures.
+    /// Wedges not built on the GPU (the compute path or [`WedgeBuild::Cpu`]); casters beyond
+    /// the device's limits; GPU failures.
     pub fn silhouette_on_gpu(
         &self,
         gpu: &Gpu,
         receivers: &Receivers,
         light: &LightShape,
     ) -> Result<casters::Silhouette, GpuError> {
+        if !self.built_on_gpu() {
+            return Err(GpuError::Failed(format!("{}: not built on the GPU", self.name())));
+        }
         let mesh = self.builder.mesh.as_ref().map_err(|e| GpuError::Failed(format!("wedges: {e}")))?;
         let (w, h) = receivers.gbuffer.size();
         let vis = gpu::Visibility::new(gpu, w, h, 1)?;
-        let mut encoder = gpu.encoder("wedge silhouette");
-        self.record_built(gpu, &mut encoder, receivers, light, None, &vis.layer(0))?;
-        gpu.submit_and_wait(encoder)?;
+        self.write_visibility(gpu, receivers, light, &vis.layer(0))?;
         let args: Vec<u32> = bytemuck::pod_collect_to_vec(&gpu::read_buffer(gpu, &mesh.args)?);
         let edges: Vec<[[f32; 4]; 4]> = bytemuck::pod_collect_to_vec(&gpu::read_buffer(gpu, &mesh.silhouette)?);
         let n = (args[12] as usize).min(edges.len());
@@ -592,6 +595,11 @@ impl Wedges {
             normals: edges[..n].iter().map(|e| [v(e[2]), v(e[3])]).collect(),
             lit_faces: Vec::new(),
         })
+    }
+
+    /// Whether lights are built on the GPU: [`WedgeBuild::Gpu`] on the raster path.
+    fn built_on_gpu(&self) -> bool {
+        self.settings.build == WedgeBuild::Gpu && self.settings.path == WedgePath::Raster
     }
 
     /// [`ShadowTechnique::record`] with the geometry built on the GPU (`gpu_build`).
@@ -641,9 +649,14 @@ impl Wedges {
         }
         let uniform_buf = buffer("wedge build", bytemuck::bytes_of(&uniform), wgpu::BufferUsages::UNIFORM);
         let casters_buf = buffer("wedge casters", bytemuck::cast_slice(&caster_words), wgpu::BufferUsages::STORAGE);
-        let light_buf = buffer("wedge light", bytemuck::cast_slice(&light_params), wgpu::BufferUsages::UNIFORM);
         let view = view_uniform(&gb.view, &view_proj, receivers.bounds, extent);
         let view_buf = buffer("wedge view", bytemuck::bytes_of(&view), wgpu::BufferUsages::UNIFORM);
+        // the wedge pass's light: the build uniform's first words (`Build.light`)
+        let light_binding = wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer: &uniform_buf,
+            offset: 0,
+            size: wgpu::BufferSize::new(std::mem::size_of_val(&light_params) as u64),
+        });
         let binds = self.builder.bind_groups(gpu, mesh, &LightBuild { uniform: &uniform_buf, casters: &casters_buf });
         let position = gb.position.create_view(&Default::default());
         let normal = gb.geometric_normal.create_view(&Default::default());
@@ -652,7 +665,7 @@ impl Wedges {
             label: Some("wedges"),
             layout: &self.polygons.get_bind_group_layout(0),
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: light_buf.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 0, resource: light_binding },
                 wgpu::BindGroupEntry { binding: 1, resource: mesh.silhouette.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&position) },
                 wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&normal) },
@@ -664,7 +677,8 @@ impl Wedges {
         // what the GPU does not write stays zero: no draw, no dispatch
         encoder.clear_buffer(&mesh.args, 0, None);
         encoder.clear_buffer(&mesh.footprint_dispatch, 0, None);
-        let (faces, edges) = if counts[0] == 0 && counts[1] == 0 { (0, 0) } else { GpuBuilder::groups(mesh) };
+        // workgroups of faces, and the edge blocks (zero when nothing is visible)
+        let (faces, edges) = (counts[0].div_ceil(gpu_build::BLOCK), counts[2]);
         let calls = Calls::new(
             gpu,
             encoder,
@@ -740,11 +754,7 @@ impl ShadowTechnique for Wedges {
             "wedges{path}{}{}",
             if self.settings.cull { "" } else { "_unculled" },
             if self.settings.cosine_weighted { "" } else { "_unweighted" }
-        ) + if self.settings.build == WedgeBuild::Cpu && self.settings.path == WedgePath::Raster {
-            "_cpu_built"
-        } else {
-            ""
-        }
+        ) + if self.settings.path == WedgePath::Raster && !self.built_on_gpu() { "_cpu_built" } else { "" }
     }
 
     fn supports(&self, _light: &LightShape) -> bool {
@@ -754,7 +764,7 @@ impl ShadowTechnique for Wedges {
     /// The GPU builder's counts: primitives drawn (volume and footprint triangles), wedges off
     /// screen or away from receivers, edges with an endpoint inside the light.
     fn read_counts(&self, gpu: &Gpu, reports: &mut [ShadowPassReport]) -> Result<(), GpuError> {
-        if self.settings.build != WedgeBuild::Gpu || self.settings.path != WedgePath::Raster {
+        if !self.built_on_gpu() {
             return Ok(());
         }
         let shadowed: Vec<&mut ShadowPassReport> = reports.iter_mut().filter(|r| r.skipped.is_none()).collect();
@@ -779,7 +789,7 @@ impl ShadowTechnique for Wedges {
         gate: Option<gpu::Gate<'_>>,
         target: &wgpu::TextureView,
     ) -> Result<ShadowPassReport, GpuError> {
-        if self.settings.build == WedgeBuild::Gpu && self.settings.path == WedgePath::Raster {
+        if self.built_on_gpu() {
             return self.record_built(gpu, encoder, receivers, light, gate, target);
         }
         let gb = receivers.gbuffer;
