@@ -31,21 +31,25 @@ pub fn animated_object(scene: &scene::Scene) -> usize {
     scene.objects.iter().position(|o| o.name != "ground").unwrap_or(0)
 }
 
-/// Where the animated object is at frame `k`: on a horizontal circle through its rest pose,
-/// of radius an eighth of its bounding box's diagonal, a new pose every frame (64 poses a turn).
+/// Where the animated object is at frame `k`: moved along a horizontal circle through its
+/// rest pose, of radius an eighth of its bounding box's diagonal, and turned about the vertical
+/// through its centre by the same angle; a new pose every frame (64 poses a turn). Frame 0 is
+/// the rest pose.
 #[must_use]
-pub fn animation_offset(scene: &scene::Scene, object: usize, k: usize) -> glam::Vec3 {
-    let Some(o) = scene.objects.get(object) else { return glam::Vec3::ZERO };
-    let (lo, hi) = o
-        .mesh
-        .positions
-        .iter()
-        .fold((glam::Vec3::splat(f32::INFINITY), glam::Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| {
-            (lo.min(*p), hi.max(*p))
-        });
-    let r = if lo.is_finite() { 0.125 * (hi - lo).length() } else { 0.0 };
+pub fn animation_pose(scene: &scene::Scene, object: usize, k: usize) -> glam::Affine3A {
+    let Some((lo, hi)) = scene.objects.get(object).and_then(|o| finite_box(&o.mesh.positions)) else {
+        return glam::Affine3A::IDENTITY;
+    };
+    if k.is_multiple_of(64) {
+        return glam::Affine3A::IDENTITY;
+    }
+    let r = 0.125 * (hi - lo).length();
     let a = std::f32::consts::TAU * (k % 64) as f32 / 64.0;
-    glam::Vec3::new(r * (a.cos() - 1.0), 0.0, r * a.sin())
+    let centre = 0.5 * (lo + hi);
+    let offset = glam::Vec3::new(r * (a.cos() - 1.0), 0.0, r * a.sin());
+    glam::Affine3A::from_translation(centre + offset)
+        * glam::Affine3A::from_rotation_y(a)
+        * glam::Affine3A::from_translation(-centre)
 }
 
 /// A frame's image (submitted, not waited for) and what its shadow passes did.
@@ -84,10 +88,13 @@ impl RenderedFrame {
 
 /// Everything a frame needs that does not change between frames.
 pub struct Frame {
-    /// The scene, its camera at the frame's size (objects at their current poses).
+    /// The scene as built (objects at rest; [`Frame::set_transform`] moves them), its camera
+    /// at the frame's size.
     pub scene: scene::Scene,
-    /// The scene as built, before any object moved.
-    rest: scene::Scene,
+    // per object, where it is: its transform from rest
+    poses: Vec<glam::Affine3A>,
+    // per object, the box around its finite vertices at rest
+    object_boxes: Vec<Option<(glam::Vec3, glam::Vec3)>>,
     /// The decomposition of the default map, EnvDirects first.
     pub decomposition: Decomposition,
     geometry: SceneGeometry,
@@ -136,32 +143,51 @@ impl Frame {
             maps: MapTechnique::new(gpu, &scene, Technique::Orthographic, maps_settings(), 1).map_err(e)?,
             reductions: [ReceiverReduction::new(gpu), ReceiverReduction::new(gpu)],
             scene_box: scene_bounds(&scene),
-            rest: scene.clone(),
+            poses: vec![glam::Affine3A::IDENTITY; scene.objects.len()],
+            object_boxes: scene.objects.iter().map(|o| finite_box(&o.mesh.positions)).collect(),
             scene,
             decomposition,
         })
     }
 
-    /// Moves object `object` to its rest pose translated by `offset`. Nothing is built: the
-    /// object's vertices are written into the G-buffer's and the maps' geometry
-    /// (`queue.write_buffer`) and its wedge caster welded again on the CPU.
+    /// Moves object `object` by `transform` from its rest pose. Nothing is built and no
+    /// vertex is written: the transform goes to the G-buffer's, the maps' and the wedges'
+    /// geometry (a `queue.write_buffer` each), whose vertices the next frame places on the GPU.
     ///
     /// # Errors
-    /// An object index out of range.
-    pub fn move_object(&mut self, gpu: &Gpu, object: usize, offset: glam::Vec3) -> Result<(), GpuError> {
-        let rest = self.rest.objects.get(object).ok_or_else(|| GpuError::Failed(format!("no object {object}")))?;
-        let moved = rest.mesh.positions.iter().map(|p| *p + offset).collect();
-        self.scene.objects[object].mesh.positions = moved;
-        self.scene_box = scene_bounds(&self.scene);
-        self.geometry.update_object(gpu, &self.scene, object)?;
-        self.wedges.update_object(gpu, &self.scene, object)?;
-        self.maps.update_object(gpu, &self.scene, object)
+    /// An object index out of range; a non-finite transform.
+    pub fn set_transform(&mut self, gpu: &Gpu, object: usize, transform: glam::Affine3A) -> Result<(), GpuError> {
+        if object >= self.poses.len() {
+            return Err(GpuError::Failed(format!("no object {object}")));
+        }
+        self.geometry.set_transform(gpu, object, transform)?;
+        self.wedges.set_transform(gpu, object, transform)?;
+        self.maps.set_transform(gpu, object, transform)?;
+        self.poses[object] = transform;
+        let boxes = self
+            .object_boxes
+            .iter()
+            .zip(&self.poses)
+            .filter_map(|(b, t)| Some(gpu::placement::transform_box(t, (*b)?)));
+        self.scene_box = boxes.reduce(|(a, b), (c, d)| (a.min(c), b.max(d)));
+        Ok(())
     }
 
-    /// The scene as built, before any object moved ([`Frame::move_object`] offsets from it).
+    /// The scene as built, before any object moved (what [`Frame::set_transform`] moves from).
     #[must_use]
     pub fn rest(&self) -> &scene::Scene {
-        &self.rest
+        &self.scene
+    }
+
+    /// The scene with every object's vertices where its transform puts them: what a frame
+    /// built afresh for the current poses would be given.
+    #[must_use]
+    pub fn posed_scene(&self) -> scene::Scene {
+        let mut posed = self.scene.clone();
+        for (o, t) in posed.objects.iter_mut().zip(&self.poses) {
+            o.mesh.transform(t);
+        }
+        posed
     }
 
     /// The frame's lights as the shading pass and the techniques see them, EnvDirects first.
@@ -343,12 +369,15 @@ impl Frame {
     }
 }
 
-/// The box around every vertex of `scene`'s objects at their current poses, `None` for none.
+/// The box around every finite vertex of `scene`'s objects, `None` for none.
 fn scene_bounds(scene: &scene::Scene) -> Option<(glam::Vec3, glam::Vec3)> {
-    let (lo, hi) = scene
-        .objects
-        .iter()
-        .flat_map(|o| &o.mesh.positions)
+    finite_box(scene.objects.iter().flat_map(|o| &o.mesh.positions))
+}
+
+/// The box around the finite points of `points`, `None` for none.
+fn finite_box<'a>(points: impl IntoIterator<Item = &'a glam::Vec3>) -> Option<(glam::Vec3, glam::Vec3)> {
+    let (lo, hi) = points
+        .into_iter()
         .filter(|p| p.is_finite())
         .fold((glam::Vec3::splat(f32::INFINITY), glam::Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| {
             (lo.min(*p), hi.max(*p))

@@ -6,7 +6,7 @@
 //! prints what each frame cost (`envshadow_benches::frame_stats`); `--animate` moves an object
 //! every frame.
 
-use envshadow_benches::decomposition::{Frame, animated_object, animation_offset};
+use envshadow_benches::decomposition::{Frame, animated_object, animation_pose};
 use envshadow_benches::frame_stats::{FrameStats, measure_frames};
 use std::path::Path;
 
@@ -63,8 +63,7 @@ pub fn run(args: &FrameArgs) -> Result<(), String> {
         let mut last = None;
         let stats = measure_frames(&gpu, args.repeats, |k| -> Result<(), gpu::GpuError> {
             if let Some(object) = moving {
-                let offset = animation_offset(frame.rest(), object, k);
-                frame.move_object(&gpu, object, offset)?;
+                frame.set_transform(&gpu, object, animation_pose(frame.rest(), object, k))?;
             }
             last = Some(frame.render(&gpu, scale)?);
             Ok(())

@@ -60,6 +60,8 @@ pub struct Gpu {
     /// Limits of the device (the adapter's, or what the caller's device was created with).
     pub limits: wgpu::Limits,
     counters: Arc<Counters>,
+    // the placement pass's pipeline, made once per device (`placement::Placement`)
+    pub(crate) place: std::sync::OnceLock<wgpu::ComputePipeline>,
 }
 
 /// What the toolkit asked of the device since it was wrapped: submissions, CPU waits, bytes
@@ -237,7 +239,7 @@ impl Gpu {
             ..Default::default()
         }))
         .map_err(|e| GpuError::Device { adapter: info.name.clone(), reason: e.to_string() })?;
-        Ok(Self { device, queue, info, features, limits, counters: Arc::default() })
+        Ok(Self { device, queue, info, features, limits, counters: Arc::default(), place: Default::default() })
     }
 
     /// Wraps a device and queue the caller already has (a winit surface's, Bevy's
@@ -249,7 +251,7 @@ impl Gpu {
     pub fn from_device(device: wgpu::Device, queue: wgpu::Queue, info: wgpu::AdapterInfo) -> Self {
         let features = device.features();
         let limits = device.limits();
-        Self { device, queue, info, features, limits, counters: Arc::default() }
+        Self { device, queue, info, features, limits, counters: Arc::default(), place: Default::default() }
     }
 
     /// What the toolkit has asked of the device so far (see [`GpuCounters`]).

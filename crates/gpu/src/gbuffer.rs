@@ -192,6 +192,7 @@ impl GBufferPass {
         geometry: &SceneGeometry,
         view: &crate::View,
     ) -> Result<GBuffer, GpuError> {
+        geometry.record_placement(gpu, encoder);
         let (w, h) = view.size();
         let size = (w, h, 1);
         let target = |label, format| crate::target::render_target(gpu, label, size, format);

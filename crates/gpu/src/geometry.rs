@@ -2,7 +2,8 @@
 //! in spatially coherent chunks (with bounding spheres) for shadow passes that cull per view.
 
 use crate::context::{Gpu, GpuError};
-use glam::Vec3;
+use crate::placement::{Placement, VertexWords, transform_box};
+use glam::{Affine3A, Vec3};
 use wgpu::util::DeviceExt;
 
 /// G-buffer vertex: position, shading normal, geometric normal, object index.
@@ -35,11 +36,18 @@ pub struct SceneGeometry {
     pub(crate) vertices: wgpu::Buffer,
     pub(crate) vertex_count: u32,
     pub(crate) materials: wgpu::Buffer,
-    /// Axis-aligned bounds of the scene.
+    /// Axis-aligned bounds of the scene, its objects where their transforms put them.
     pub bounds: (Vec3, Vec3),
-    // per object: first vertex, vertex count, bounds
+    // per object: first vertex, vertex count, bounds in object space
     objects: Vec<(u32, u32, (Vec3, Vec3))>,
+    placement: Placement,
 }
+
+/// Usage of vertex buffers a [`Placement`] moves: drawn, written, copied and placed.
+const PLACED: wgpu::BufferUsages = wgpu::BufferUsages::VERTEX
+    .union(wgpu::BufferUsages::COPY_DST)
+    .union(wgpu::BufferUsages::COPY_SRC)
+    .union(wgpu::BufferUsages::STORAGE);
 
 /// Largest vertex count we upload (16 M triangles): refused before allocating.
 const MAX_VERTICES: u64 = 48 << 20;
@@ -103,25 +111,57 @@ impl SceneGeometry {
         let vertices_buf = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("scene vertices"),
             contents: bytemuck::cast_slice(&vertices),
-            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+            usage: PLACED,
         });
         let materials_buf = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("materials"),
             contents: bytemuck::cast_slice(&materials),
             usage: wgpu::BufferUsages::STORAGE,
         });
+        let words = VertexWords { count: vertices.len() as u32, stride: 10, normals: 2, object_word: 9 };
         Ok(Self {
             vertices: vertices_buf,
             vertex_count: vertices.len() as u32,
             materials: materials_buf,
             bounds: union(objects.iter().map(|o| o.2)),
+            placement: Placement::new(gpu, words, objects.len())?,
             objects,
         })
     }
 
+    /// Sets object `object`'s transform (from its mesh as uploaded, object space, to the
+    /// world): one `queue.write_buffer`; the G-buffer pass that next draws the geometry places
+    /// its vertices on the GPU first. The bounds follow.
+    ///
+    /// # Errors
+    /// [`GpuError::Failed`] for an object out of range or a non-finite transform.
+    pub fn set_transform(&mut self, gpu: &Gpu, object: usize, transform: Affine3A) -> Result<(), GpuError> {
+        self.placement.set(gpu, &self.vertices, object, transform)?;
+        self.bounds = self.world_bounds();
+        Ok(())
+    }
+
+    /// Object `object`'s transform (the identity until [`SceneGeometry::set_transform`]).
+    #[must_use]
+    pub fn transform(&self, object: usize) -> Affine3A {
+        self.placement.transform(object)
+    }
+
+    fn world_bounds(&self) -> (Vec3, Vec3) {
+        union(self.objects.iter().enumerate().map(|(k, o)| transform_box(&self.placement.transform(k), o.2)))
+    }
+
+    /// Records the placement of moved objects' vertices (nothing when none moved): what the
+    /// G-buffer pass calls before drawing.
+    pub(crate) fn record_placement(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder) {
+        self.placement.record(gpu, encoder, &self.vertices);
+    }
+
     /// Writes object `object`'s vertices from its mesh in `scene` (same triangles, new
-    /// positions or normals: a pose change) with `queue.write_buffer`, and updates the bounds:
+    /// positions or normals: a deformation) with `queue.write_buffer`, and updates the bounds:
     /// what [`SceneGeometry::upload`] of the changed scene would hold, without a new buffer.
+    /// Its transform ([`SceneGeometry::set_transform`]) still applies; a rigid motion needs only
+    /// that.
     ///
     /// # Errors
     /// [`GpuError::Failed`] for an object out of range or with another triangle count.
@@ -139,10 +179,10 @@ impl SceneGeometry {
         let (vertices, bounds) = object_vertices(object, o);
         if !vertices.is_empty() {
             let offset = u64::from(first) * std::mem::size_of::<ShadedVertex>() as u64;
-            gpu.queue.write_buffer(&self.vertices, offset, bytemuck::cast_slice(&vertices));
+            self.placement.write_vertices(gpu, &self.vertices, offset, bytemuck::cast_slice(&vertices));
         }
         self.objects[object].2 = bounds;
-        self.bounds = union(self.objects.iter().map(|o| o.2));
+        self.bounds = self.world_bounds();
         Ok(())
     }
 
@@ -168,15 +208,23 @@ pub struct Chunk {
 
 /// Position-only triangle soup for depth passes, in chunks that can be culled per view.
 pub struct ShadowGeometry {
-    /// Vertex buffer: `[f32; 3]` positions, three per triangle.
+    /// Vertex buffer: a `[f32; 3]` position and the `u32` object index, three vertices per
+    /// triangle ([`ShadowGeometry::LAYOUT`]).
     pub vertices: wgpu::Buffer,
-    /// The chunks, covering every triangle once.
+    /// The chunks, covering every triangle once, with their bounds where the objects'
+    /// transforms put them.
     pub chunks: Vec<Chunk>,
     /// Triangle count.
     pub triangles: u32,
-    // triangles per chunk (the last may have fewer), and every triangle, for bounds updates
+    // triangles per chunk (the last may have fewer), and every triangle as uploaded (object
+    // space), for bounds updates
     chunk_triangles: usize,
     soup: Vec<[Vec3; 3]>,
+    // per object, its first triangle and count
+    objects: Vec<(usize, usize)>,
+    // per chunk, the bounding sphere of each object's triangles in it, object space
+    parts: Vec<Vec<(u32, Vec3, f32)>>,
+    placement: Placement,
 }
 
 /// A chunk's bounding sphere: the centre of its box and the farthest vertex from it.
@@ -190,50 +238,169 @@ fn chunk_sphere(tris: &[[Vec3; 3]]) -> (Vec3, f32) {
     (center, tris.iter().flatten().map(|p| p.distance(center)).fold(0.0, f32::max))
 }
 
+/// A sphere holding every one of `spheres`.
+fn sphere_of_spheres(spheres: &[(Vec3, f32)]) -> (Vec3, f32) {
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for &(c, r) in spheres {
+        lo = lo.min(c - Vec3::splat(r));
+        hi = hi.max(c + Vec3::splat(r));
+    }
+    let center = 0.5 * (lo + hi);
+    (center, spheres.iter().map(|&(c, r)| c.distance(center) + r).fold(0.0, f32::max))
+}
+
 impl ShadowGeometry {
     /// Triangles per chunk by default: small enough to cull walls row by row, large enough that
     /// draw calls stay few.
     pub const CHUNK_TRIANGLES: usize = 16;
 
-    /// Uploads `triangles` (world space) in chunks of `chunk_triangles` consecutive triangles.
+    /// Uploads `triangles` (world space, one object) in chunks of `chunk_triangles`
+    /// consecutive triangles.
     ///
     /// # Errors
     /// [`GpuError::TooLarge`] beyond the buffer limits.
     pub fn upload(gpu: &Gpu, triangles: &[[Vec3; 3]], chunk_triangles: usize) -> Result<Self, GpuError> {
-        check_count(gpu, triangles.len() * 3, 12)?;
-        let chunks = triangles
-            .chunks(chunk_triangles.max(1))
+        Self::upload_objects(gpu, &[triangles], chunk_triangles)
+    }
+
+    /// Uploads the triangles of each object of `objects` (object space), one after the other,
+    /// in chunks of `chunk_triangles` consecutive triangles; each object can then be moved by
+    /// its transform ([`ShadowGeometry::set_transform`]).
+    ///
+    /// # Errors
+    /// [`GpuError::TooLarge`] beyond the buffer limits.
+    pub fn upload_objects(gpu: &Gpu, objects: &[&[[Vec3; 3]]], chunk_triangles: usize) -> Result<Self, GpuError> {
+        let count: usize = objects.iter().map(|o| o.len()).sum();
+        check_count(gpu, count * 3, 16)?;
+        let n = chunk_triangles.max(1);
+        let mut soup = Vec::with_capacity(count);
+        let mut ranges = Vec::with_capacity(objects.len());
+        let mut flat: Vec<[u32; 4]> = Vec::with_capacity(count * 3);
+        for (k, tris) in objects.iter().enumerate() {
+            ranges.push((soup.len(), tris.len()));
+            soup.extend_from_slice(tris);
+            flat.extend(tris.iter().flatten().map(|p| {
+                let [x, y, z] = p.to_array().map(f32::to_bits);
+                [x, y, z, k as u32]
+            }));
+        }
+        let chunks = soup
+            .chunks(n)
             .enumerate()
             .map(|(k, tris)| {
                 let (center, radius) = chunk_sphere(tris);
-                let first = (k * chunk_triangles.max(1) * 3) as u32;
-                Chunk { first_vertex: first, vertex_count: (tris.len() * 3) as u32, center, radius }
+                Chunk { first_vertex: (k * n * 3) as u32, vertex_count: (tris.len() * 3) as u32, center, radius }
             })
             .collect();
-        let flat: Vec<[f32; 3]> = triangles.iter().flatten().map(|p| p.to_array()).collect();
         let vertices = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("shadow vertices"),
-            contents: bytemuck::cast_slice(if flat.is_empty() { &[[0.0f32; 3]; 3][..] } else { &flat[..] }),
-            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+            contents: bytemuck::cast_slice(if flat.is_empty() { &[[0u32; 4]; 3][..] } else { &flat[..] }),
+            usage: PLACED,
         });
-        Ok(Self {
+        let words = VertexWords { count: flat.len() as u32, stride: 4, normals: 0, object_word: 3 };
+        let mut out = Self {
             vertices,
             chunks,
-            triangles: triangles.len() as u32,
-            chunk_triangles: chunk_triangles.max(1),
-            soup: triangles.to_vec(),
-        })
+            triangles: count as u32,
+            chunk_triangles: n,
+            soup,
+            parts: Vec::new(),
+            placement: Placement::new(gpu, words, ranges.len())?,
+            objects: ranges,
+        };
+        out.parts = (0..out.chunks.len()).map(|k| out.chunk_parts(k)).collect();
+        Ok(out)
     }
 
-    /// Every triangle, in the order of the vertex buffer (world space).
+    /// The object of triangle `t`.
+    fn object_of(&self, t: usize) -> usize {
+        self.objects.partition_point(|&(first, count)| first + count <= t)
+    }
+
+    /// Chunk `k`'s bounding sphere of each object's triangles in it (object space).
+    fn chunk_parts(&self, k: usize) -> Vec<(u32, Vec3, f32)> {
+        let n = self.chunk_triangles;
+        let (start, end) = (k * n, ((k + 1) * n).min(self.soup.len()));
+        let mut parts = Vec::new();
+        let mut t = start;
+        while t < end {
+            let object = self.object_of(t);
+            let stop = self.objects.get(object).map_or(end, |&(first, count)| (first + count).min(end)).max(t + 1);
+            let (c, r) = chunk_sphere(&self.soup[t..stop]);
+            parts.push((object as u32, c, r));
+            t = stop;
+        }
+        parts
+    }
+
+    /// Chunk `k`'s bounds where the transforms put its triangles: as uploaded while they are
+    /// all the identity.
+    fn place_chunk(&mut self, k: usize) {
+        let n = self.chunk_triangles;
+        let parts = &self.parts[k];
+        let moved = parts.iter().any(|p| self.placement.transform(p.0 as usize) != Affine3A::IDENTITY);
+        let (center, radius) = if !moved {
+            chunk_sphere(&self.soup[k * n..((k + 1) * n).min(self.soup.len())])
+        } else {
+            let spheres: Vec<(Vec3, f32)> = parts
+                .iter()
+                .map(|&(o, c, r)| crate::placement::transform_sphere(&self.placement.transform(o as usize), (c, r)))
+                .collect();
+            sphere_of_spheres(&spheres)
+        };
+        self.chunks[k].center = center;
+        self.chunks[k].radius = radius;
+    }
+
+    /// Every triangle, in the order of the vertex buffer, in world space (where the objects'
+    /// transforms put them).
     #[must_use]
-    pub fn triangle_soup(&self) -> &[[Vec3; 3]] {
-        &self.soup
+    pub fn triangle_soup(&self) -> std::borrow::Cow<'_, [[Vec3; 3]]> {
+        if !self.placement.in_use() {
+            return std::borrow::Cow::Borrowed(&self.soup);
+        }
+        let mut out = Vec::with_capacity(self.soup.len());
+        for (k, &(first, count)) in self.objects.iter().enumerate() {
+            let t = self.placement.transform(k);
+            out.extend(self.soup[first..first + count].iter().map(|tri| tri.map(|p| t.transform_point3(p))));
+        }
+        std::borrow::Cow::Owned(out)
     }
 
-    /// Replaces triangles `first..first + triangles.len()` (a moved object's) with
-    /// `queue.write_buffer` and recomputes the bounds of the chunks they fall in: what
-    /// [`ShadowGeometry::upload`] of the changed soup would give, without a new buffer.
+    /// Sets object `object`'s transform (from its triangles as uploaded to the world): one
+    /// `queue.write_buffer`; the depth passes that next draw the geometry place its vertices on
+    /// the GPU first ([`ShadowGeometry::record_placement`]). Its chunks' bounds follow.
+    ///
+    /// # Errors
+    /// [`GpuError::Failed`] for an object out of range or a non-finite transform.
+    pub fn set_transform(&mut self, gpu: &Gpu, object: usize, transform: Affine3A) -> Result<(), GpuError> {
+        self.placement.set(gpu, &self.vertices, object, transform)?;
+        let (first, count) = self.objects[object];
+        if count > 0 {
+            let n = self.chunk_triangles;
+            for k in first / n..(first + count).div_ceil(n) {
+                self.place_chunk(k);
+            }
+        }
+        Ok(())
+    }
+
+    /// Object `object`'s transform (the identity until [`ShadowGeometry::set_transform`]).
+    #[must_use]
+    pub fn transform(&self, object: usize) -> Affine3A {
+        self.placement.transform(object)
+    }
+
+    /// Records the placement of moved objects' vertices into `encoder` (nothing when none
+    /// moved since the last): before any pass that draws [`ShadowGeometry::vertices`].
+    pub fn record_placement(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder) {
+        self.placement.record(gpu, encoder, &self.vertices);
+    }
+
+    /// Replaces triangles `first..first + triangles.len()` (as uploaded: a deformed object's)
+    /// with `queue.write_buffer` and recomputes the bounds of the chunks they fall in: what
+    /// [`ShadowGeometry::upload_objects`] of the changed triangles would give, without a new
+    /// buffer. The objects' transforms still apply.
     ///
     /// # Errors
     /// [`GpuError::Failed`] for a range past the end.
@@ -249,21 +416,28 @@ impl ShadowGeometry {
             return Ok(());
         }
         self.soup[first..end].copy_from_slice(triangles);
-        let flat: Vec<[f32; 3]> = triangles.iter().flatten().map(|p| p.to_array()).collect();
-        gpu.queue.write_buffer(&self.vertices, first as u64 * 36, bytemuck::cast_slice(&flat));
+        let flat: Vec<[u32; 4]> = (first..end)
+            .flat_map(|t| {
+                let object = self.object_of(t) as u32;
+                self.soup[t].map(|p| {
+                    let [x, y, z] = p.to_array().map(f32::to_bits);
+                    [x, y, z, object]
+                })
+            })
+            .collect();
+        self.placement.write_vertices(gpu, &self.vertices, first as u64 * 48, bytemuck::cast_slice(&flat));
         let n = self.chunk_triangles;
         for k in first / n..end.div_ceil(n) {
-            let tris = &self.soup[k * n..((k + 1) * n).min(self.soup.len())];
-            let (center, radius) = chunk_sphere(tris);
-            self.chunks[k].center = center;
-            self.chunks[k].radius = radius;
+            self.parts[k] = self.chunk_parts(k);
+            self.place_chunk(k);
         }
         Ok(())
     }
 
-    /// Vertex layout: one `vec3<f32>` position at location 0.
+    /// Vertex layout: one `vec3<f32>` position at location 0 (16 bytes a vertex: the object
+    /// index follows it).
     pub const LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
-        array_stride: 12,
+        array_stride: 16,
         step_mode: wgpu::VertexStepMode::Vertex,
         attributes: &wgpu::vertex_attr_array![0 => Float32x3],
     };

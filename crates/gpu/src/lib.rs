@@ -20,6 +20,7 @@ mod gate;
 mod gbuffer;
 mod geometry;
 mod interleave;
+pub mod placement;
 mod readback;
 mod receivers;
 mod shade;

@@ -15,8 +15,9 @@
 //! horizon) sees the edge's outline mirrored, and the wedge term flips its sign there
 //! (`coverage::oriented_edge_term`).
 
-use glam::Vec3;
+use glam::{Affine3A, Vec3};
 use gpu::LightShape;
+use std::borrow::Cow;
 use std::collections::HashMap;
 
 /// One object's welded mesh.
@@ -24,14 +25,16 @@ use std::collections::HashMap;
 pub struct Caster {
     /// The object's name.
     pub name: String,
-    /// Welded positions.
+    /// Welded positions, object space (as the mesh was given).
     pub positions: Vec<Vec3>,
     /// Non-degenerate triangles over `positions`.
     pub triangles: Vec<[u32; 3]>,
     /// Closed and consistently wound (see the module doc); else it casts as a two-sided sheet.
     pub closed: bool,
-    /// Bounding sphere (centre, radius).
+    /// Bounding sphere (centre, radius), object space.
     pub bounds: (Vec3, f32),
+    /// Object space to world: where the caster is ([`crate::Wedges::set_transform`]).
+    pub transform: Affine3A,
 }
 
 impl Caster {
@@ -79,7 +82,30 @@ impl Caster {
             .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
         let center = if lo.is_finite() { 0.5 * (lo + hi) } else { Vec3::ZERO };
         let radius = welded.iter().map(|p| p.distance(center)).fold(0.0, f32::max);
-        Self { name: name.into(), positions: welded, triangles, closed, bounds: (center, radius) }
+        Self {
+            name: name.into(),
+            positions: welded,
+            triangles,
+            closed,
+            bounds: (center, radius),
+            transform: Affine3A::IDENTITY,
+        }
+    }
+
+    /// The bounding sphere where the transform puts the caster.
+    #[must_use]
+    pub fn world_bounds(&self) -> (Vec3, f32) {
+        gpu::placement::transform_sphere(&self.transform, self.bounds)
+    }
+
+    /// The welded positions where the transform puts them (borrowed for the identity).
+    #[must_use]
+    pub fn world_positions(&self) -> Cow<'_, [Vec3]> {
+        if self.transform == Affine3A::IDENTITY {
+            Cow::Borrowed(&self.positions)
+        } else {
+            Cow::Owned(self.positions.iter().map(|&p| self.transform.transform_point3(p)).collect())
+        }
     }
 }
 
@@ -148,11 +174,12 @@ fn facing(n: Vec3, a: Vec3, light: &LightShape) -> f32 {
 
 fn silhouette_of(c: &Caster, light: &LightShape) -> Silhouette {
     let mut out = Silhouette::default();
+    let positions = c.world_positions();
     // net directed count per undirected edge: +1 per lit face winding it low -> high, and the
     // sums of its lit faces' unit normals (facing the light) and its unlit ones'
     let mut net: HashMap<(u32, u32), (i32, Vec3, Vec3)> = HashMap::new();
     for &[a, b, cc] in &c.triangles {
-        let [pa, pb, pc] = [a, b, cc].map(|i| c.positions[i as usize]);
+        let [pa, pb, pc] = [a, b, cc].map(|i| positions[i as usize]);
         let f = facing((pb - pa).cross(pc - pa), pa, light);
         let tri = if f > 0.0 {
             [a, b, cc]
@@ -168,7 +195,7 @@ fn silhouette_of(c: &Caster, light: &LightShape) -> Silhouette {
             }
             continue;
         };
-        let face = tri.map(|i| c.positions[i as usize]);
+        let face = tri.map(|i| positions[i as usize]);
         let normal = (face[1] - face[0]).cross(face[2] - face[0]).normalize_or_zero();
         out.lit_faces.push(face);
         for k in 0..3 {
@@ -184,7 +211,7 @@ fn silhouette_of(c: &Caster, light: &LightShape) -> Silhouette {
     for ((lo, hi), (n, lit, unlit)) in keys {
         let (a, b) = if n > 0 { (lo, hi) } else { (hi, lo) };
         for _ in 0..n.unsigned_abs() {
-            out.edges.push([c.positions[a as usize], c.positions[b as usize]]);
+            out.edges.push([positions[a as usize], positions[b as usize]]);
             out.normals.push([lit.normalize_or_zero(), unlit.normalize_or_zero()]);
         }
     }

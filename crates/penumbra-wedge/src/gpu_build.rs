@@ -35,7 +35,9 @@ const COUNT_SLOTS: u32 = 256;
 
 /// The casters as the builder reads them, and its scratch, sized for them.
 pub(crate) struct MeshBuffers {
+    // world positions, placed from the welded ones by the casters' transforms
     positions: wgpu::Buffer,
+    placement: gpu::placement::Placement,
     faces: wgpu::Buffer,
     edges: wgpu::Buffer,
     edge_faces: wgpu::Buffer,
@@ -122,11 +124,22 @@ fn hilbert(p: glam::Vec3, centre: glam::Vec3, radius: f32) -> u64 {
     (0..BITS).rev().fold(0u64, |h, b| (0..3).fold(h, |h, i| (h << 1) | u64::from((x[i] >> b) & 1)))
 }
 
+/// Caster `k`'s welded positions as the builder's buffer holds them: xyz, then the caster's
+/// index (a `u32`: what the placement reads; the shaders read xyz only).
+fn caster_positions(k: usize, c: &crate::casters::Caster) -> Vec<[f32; 4]> {
+    c.positions.iter().map(|p| p.extend(f32::from_bits(k as u32)).to_array()).collect()
+}
+
 fn positions_of(casters: &Casters) -> Vec<[f32; 4]> {
-    casters.casters.iter().flat_map(|c| c.positions.iter().map(|p| p.extend(1.0).to_array())).collect()
+    casters.casters.iter().enumerate().flat_map(|(k, c)| caster_positions(k, c)).collect()
 }
 
 impl MeshBuffers {
+    /// Records the placement of moved casters' vertices (nothing when none moved).
+    pub(crate) fn record_placement(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder) {
+        self.placement.record(gpu, encoder, &self.positions);
+    }
+
     fn new(gpu: &Gpu, casters: &Casters, edges_per_footprint: u32) -> Result<Self, GpuError> {
         let mut faces: Vec<[u32; 4]> = Vec::new();
         let mut bases = Vec::with_capacity(casters.casters.len());
@@ -208,8 +221,18 @@ impl MeshBuffers {
         };
         let read = wgpu::BufferUsages::STORAGE;
         let blocks = (edges.len() as u64).div_ceil(u64::from(BLOCK));
+        let placed = read | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC;
+        let positions_buf = init("caster positions", bytemuck::cast_slice(&positions), placed);
+        let words =
+            gpu::placement::VertexWords { count: positions.len() as u32, stride: 4, normals: 0, object_word: 3 };
+        let mut placement = gpu::placement::Placement::new(gpu, words, casters.casters.len())?;
+        // a rebuilt mesh keeps where its casters are
+        for (k, c) in casters.casters.iter().enumerate() {
+            placement.set(gpu, &positions_buf, k, c.transform)?;
+        }
         Ok(Self {
-            positions: init("caster positions", bytemuck::cast_slice(&positions), read | wgpu::BufferUsages::COPY_DST),
+            positions: positions_buf,
+            placement,
             faces: init("caster faces", bytemuck::cast_slice(&faces), read),
             edges: init("caster edges", bytemuck::cast_slice(&edges), read),
             edge_faces: init("caster edge faces", bytemuck::cast_slice(&edge_faces), read),
@@ -302,14 +325,27 @@ impl GpuBuilder {
             && let Ok(mesh) = &self.mesh
             && let Some(&base) = mesh.bases.get(object)
         {
-            let data: Vec<[f32; 4]> =
-                casters.casters[object].positions.iter().map(|p| p.extend(1.0).to_array()).collect();
+            let data = caster_positions(object, &casters.casters[object]);
             if !data.is_empty() {
-                gpu.queue.write_buffer(&mesh.positions, u64::from(base) * 16, bytemuck::cast_slice(&data));
+                mesh.placement.write_vertices(gpu, &mesh.positions, u64::from(base) * 16, bytemuck::cast_slice(&data));
             }
             return;
         }
         self.mesh = MeshBuffers::new(gpu, casters, edges_per_footprint);
+    }
+
+    /// Caster `object`'s transform: written for the placement (a mesh that could not be
+    /// built has nothing to place).
+    pub(crate) fn set_transform(
+        &mut self,
+        gpu: &Gpu,
+        object: usize,
+        transform: glam::Affine3A,
+    ) -> Result<(), GpuError> {
+        match &mut self.mesh {
+            Ok(mesh) => mesh.placement.set(gpu, &mesh.positions, object, transform),
+            Err(_) => Ok(()),
+        }
     }
 
     /// Bind groups of the five dispatches for one light.

@@ -261,8 +261,9 @@ fn edge_sum_texture(gpu: &Gpu, (w, h): (u32, u32)) -> wgpu::Texture {
 fn casters_bounds(casters: &Casters) -> (Vec3, Vec3) {
     let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
     for c in &casters.casters {
-        lo = lo.min(c.bounds.0 - Vec3::splat(c.bounds.1));
-        hi = hi.max(c.bounds.0 + Vec3::splat(c.bounds.1));
+        let (centre, r) = c.world_bounds();
+        lo = lo.min(centre - Vec3::splat(r));
+        hi = hi.max(centre + Vec3::splat(r));
     }
     (lo, hi)
 }
@@ -275,7 +276,7 @@ fn segment_meets_box(a: Vec3, b: Vec3, bounds: (Vec3, Vec3)) -> bool {
 /// Whether any shadow of `caster` from `light` can land in `receivers` within `extent`: its
 /// bounding sphere swept away from the light, widened by the penumbra, against the box.
 fn shadow_can_reach(caster: &Caster, light: &LightShape, receivers: (Vec3, Vec3), extent: f32) -> bool {
-    let (c, r) = caster.bounds;
+    let (c, r) = caster.world_bounds();
     let (dir, tan_spread) = match *light {
         LightShape::Distant { direction, half_angle } => {
             (-direction.normalize_or(Vec3::Y), half_angle.clamp(0.0, LightShape::MAX_HALF_ANGLE).tan())
@@ -413,12 +414,30 @@ impl Wedges {
         let (Some(slot), Some(o)) = (self.casters.casters.get_mut(object), scene.objects.get(object)) else {
             return Err(GpuError::Failed(format!("wedges: no object {object}")));
         };
-        let moved = Caster::new(&o.name, &o.mesh.positions, &o.mesh.indices);
+        let mut moved = Caster::new(&o.name, &o.mesh.positions, &o.mesh.indices);
+        moved.transform = slot.transform;
         // the same welded triangles: the builder's buffers hold its topology already
         let same = moved.triangles == slot.triangles && moved.positions.len() == slot.positions.len();
         *slot = moved;
         self.bounds = casters_bounds(&self.casters);
         self.builder.update(gpu, &self.casters, object, same, self.settings.edges_per_footprint);
+        Ok(())
+    }
+
+    /// Sets object `object`'s transform (from its mesh as the wedges were made with, to the
+    /// world): a rigid (or any affine) motion without welding or building anything. One
+    /// `queue.write_buffer`; the next light recorded places the casters' vertices on the GPU
+    /// first. The CPU builder ([`Wedges::plan`]) and the culling use the same transform.
+    ///
+    /// # Errors
+    /// [`GpuError::Failed`] for an object out of range or a non-finite transform.
+    pub fn set_transform(&mut self, gpu: &Gpu, object: usize, transform: glam::Affine3A) -> Result<(), GpuError> {
+        let Some(slot) = self.casters.casters.get_mut(object) else {
+            return Err(GpuError::Failed(format!("wedges: no object {object}")));
+        };
+        self.builder.set_transform(gpu, object, transform)?;
+        slot.transform = transform;
+        self.bounds = casters_bounds(&self.casters);
         Ok(())
     }
 
@@ -540,7 +559,7 @@ impl Wedges {
     fn volume_length(&self, caster: &Caster, light: &LightShape, rb: (Vec3, Vec3), extent: f32) -> f32 {
         match *light {
             LightShape::Distant { direction, .. } if self.settings.cull => {
-                let (c, r) = caster.bounds;
+                let (c, r) = caster.world_bounds();
                 reach_along(c, r, -direction.normalize_or(Vec3::Y), 0.0, rb, extent).unwrap_or(0.0).max(r * 1e-3) + r
             }
             _ => extent,
@@ -674,6 +693,8 @@ impl Wedges {
         });
         let scratch = self.scratch(gpu, gb.size())?;
         let acc = &scratch.accumulator;
+        // moved casters' vertices first (nothing when none moved)
+        mesh.record_placement(gpu, encoder);
         // what the GPU does not write stays zero: no draw, no dispatch
         encoder.clear_buffer(&mesh.args, 0, None);
         encoder.clear_buffer(&mesh.footprint_dispatch, 0, None);

@@ -24,6 +24,21 @@ fn lights() -> Vec<LightShape> {
     ]
 }
 
+/// What the camera of `scene` sees: its G-buffer and the points read back from it.
+fn seen(gpu: &Gpu, scene: &Scene) -> (gpu::GBuffer, Vec<(Vec3, Vec3)>) {
+    let geometry = SceneGeometry::upload(gpu, scene).unwrap();
+    let gb = GBufferPass::new(gpu).render(gpu, &geometry, &scene.camera).unwrap();
+    let points = gb.read_points(gpu).unwrap();
+    (gb, points)
+}
+
+/// Object `object` of `scene` turned and moved by `t`, on the CPU.
+fn posed(scene: &Scene, object: usize, t: glam::Affine3A) -> Scene {
+    let mut moved = scene.clone();
+    moved.objects[object].mesh.transform(&t);
+    moved
+}
+
 /// Per light its layer, every light recorded into one encoder; the counters while recording.
 fn recorded(
     gpu: &Gpu,
@@ -54,9 +69,7 @@ fn waited(gpu: &Gpu, wedges: &Wedges, receivers: &Receivers, lights: &[LightShap
 fn all_lights_recorded_in_one_encoder_equal_each_light_waited_for() {
     let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
     let scene = scene();
-    let geometry = SceneGeometry::upload(&gpu, &scene).unwrap();
-    let gb = GBufferPass::new(&gpu).render(&gpu, &geometry, &scene.camera).unwrap();
-    let points = gb.read_points(&gpu).unwrap();
+    let (gb, points) = seen(&gpu, &scene);
     let receivers = Receivers::new(&gb, &points);
     let lights = lights();
     for path in [WedgePath::Raster, WedgePath::Compute] {
@@ -81,13 +94,8 @@ fn a_moved_caster_shadows_as_wedges_built_for_its_pose() {
     let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
     let rest = scene();
     let object = rest.objects.iter().position(|o| o.name != "ground").unwrap();
-    let mut moved = rest.clone();
-    for p in &mut moved.objects[object].mesh.positions {
-        *p += Vec3::new(0.31, 0.0, -0.17);
-    }
-    let geometry = SceneGeometry::upload(&gpu, &moved).unwrap();
-    let gb = GBufferPass::new(&gpu).render(&gpu, &geometry, &moved.camera).unwrap();
-    let points = gb.read_points(&gpu).unwrap();
+    let moved = posed(&rest, object, glam::Affine3A::from_translation(Vec3::new(0.31, 0.0, -0.17)));
+    let (gb, points) = seen(&gpu, &moved);
     let receivers = Receivers::new(&gb, &points);
     let lights = lights();
     let mut updated = Wedges::new(&gpu, &rest, WedgeSettings::default());
@@ -158,4 +166,47 @@ fn wedges_gated_on_the_gpu_and_planned_for_a_looser_box_equal_wedges_planned_for
             );
         }
     }
+}
+
+/// Texels of `a` and `b` further apart than 0.02, and the largest difference.
+fn apart(a: &[Vec<f32>], b: &[Vec<f32>]) -> (usize, f32) {
+    let d = a.iter().flatten().zip(b.iter().flatten()).map(|(x, y)| (x - y).abs());
+    d.fold((0, 0.0f32), |(n, m), d| (n + usize::from(d > 0.02), m.max(d)))
+}
+
+#[test]
+fn a_transformed_caster_shadows_as_its_mesh_moved_on_the_cpu() {
+    // the transform placed on the GPU (GPU builder) and applied to the welded positions on the
+    // CPU (CPU builder), against wedges built for the moved mesh: the same edges a rounding
+    // apart, the bounds moved rather than measured (a hair wider: the extent moves)
+    let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
+    let rest = scene();
+    let object = rest.objects.iter().position(|o| o.name != "ground").unwrap();
+    let t = glam::Affine3A::from_translation(Vec3::new(0.31, 0.05, -0.17)) * glam::Affine3A::from_rotation_y(0.6);
+    let moved = posed(&rest, object, t);
+    let (gb, points) = seen(&gpu, &moved);
+    let receivers = Receivers::new(&gb, &points);
+    let lights = lights();
+    let texels = lights.len() * points.len();
+    for build in [penumbra_wedge::WedgeBuild::Gpu, penumbra_wedge::WedgeBuild::Cpu] {
+        let settings = WedgeSettings { build, ..WedgeSettings::default() };
+        let mut placed = Wedges::new(&gpu, &rest, settings);
+        let at_rest = recorded(&gpu, &placed, &receivers, &lights).0;
+        let before = gpu.counters();
+        placed.set_transform(&gpu, object, t).unwrap();
+        let d = gpu.counters() - before;
+        assert_eq!((d.submits, d.waits, d.pipelines), (0, 0, 0), "{build:?}: moving submitted, waited or built");
+        let (a, during) = recorded(&gpu, &placed, &receivers, &lights);
+        assert_eq!((during.submits, during.waits, during.pipelines), (0, 0, 0), "{build:?}: recording");
+        let fresh = recorded(&gpu, &Wedges::new(&gpu, &moved, settings), &receivers, &lights).0;
+        let (n, max) = apart(&a, &fresh);
+        assert!(n * 2000 <= texels, "{build:?}: {n} of {texels} texels apart (largest {max})");
+        assert!(apart(&a, &at_rest).0 * 50 > texels, "{build:?}: the shadows did not move with the caster");
+        // back at rest: bit for bit
+        placed.set_transform(&gpu, object, glam::Affine3A::IDENTITY).unwrap();
+        assert!(recorded(&gpu, &placed, &receivers, &lights).0 == at_rest, "{build:?}: back at rest");
+    }
+    let mut wedges = Wedges::new(&gpu, &rest, WedgeSettings::default());
+    assert!(wedges.set_transform(&gpu, rest.objects.len(), t).is_err());
+    assert!(wedges.set_transform(&gpu, object, glam::Affine3A::from_scale(Vec3::splat(f32::NAN))).is_err());
 }

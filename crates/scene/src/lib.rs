@@ -21,7 +21,7 @@ pub use builtin::BUILTIN_SCENES;
 pub use camera::{Camera, CameraRays};
 pub use light::{DistantLight, cone_cosine_integral};
 pub use material::{Ggx, Material};
-pub use mesh::Mesh;
+pub use mesh::{Mesh, normal_matrix};
 
 use glam::Vec3;
 

@@ -3,7 +3,20 @@
 //! Triangles wind counter-clockwise seen from outside: the geometric normal (b - a) x (c - a)
 //! points out. Meshes with `normals` shade with interpolated vertex normals; the others flat.
 
-use glam::Vec3;
+use glam::{Affine3A, Mat3, Vec3};
+
+/// The matrix normals transform by: the cofactor matrix of `linear` (the inverse transpose
+/// times the determinant), its sign the determinant's. Unlike the inverse it exists for a
+/// flattened object too (its normals then come out as they should, or zero).
+#[must_use]
+pub fn normal_matrix(linear: Mat3) -> Mat3 {
+    if linear == Mat3::IDENTITY {
+        return Mat3::IDENTITY;
+    }
+    let (a, b, c) = (linear.x_axis, linear.y_axis, linear.z_axis);
+    let cof = Mat3::from_cols(b.cross(c), c.cross(a), a.cross(b));
+    if linear.determinant() < 0.0 { -cof } else { cof }
+}
 
 /// An indexed triangle mesh in world space.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -17,6 +30,26 @@ pub struct Mesh {
 }
 
 impl Mesh {
+    /// Moves the mesh by `t`: positions by `t`, normals by its [`normal_matrix`] and made unit
+    /// again (zero where `t` flattens the object). A mirror turns the triangles' winding back,
+    /// so that they still wind counter-clockwise seen from outside.
+    pub fn transform(&mut self, t: &Affine3A) {
+        for p in &mut self.positions {
+            *p = t.transform_point3(*p);
+        }
+        if t.matrix3.determinant() < 0.0 {
+            for tri in &mut self.indices {
+                tri.swap(1, 2);
+            }
+        }
+        if let Some(normals) = &mut self.normals {
+            let n = normal_matrix(Mat3::from(t.matrix3));
+            for v in normals {
+                *v = (n * *v).normalize_or_zero();
+            }
+        }
+    }
+
     /// Checks the mesh: indices in range, normals (if any) one per vertex and unit length, finite
     /// positions, no degenerate triangles. Returns the first problem found.
     ///

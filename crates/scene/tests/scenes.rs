@@ -1,8 +1,8 @@
 //! The built-in scenes: validity, the exact validation scene, tessellation accuracy, winding,
 //! and OBJ export that reproduces the geometry.
 
-use glam::Vec3;
-use scene::{BUILTIN_SCENES, Mesh, Scene};
+use glam::{Affine3A, Mat3, Vec3};
+use scene::{BUILTIN_SCENES, Mesh, Scene, normal_matrix};
 
 fn all() -> Vec<Scene> {
     BUILTIN_SCENES.iter().map(|n| Scene::builtin(n).unwrap_or_else(|e| panic!("{e}"))).collect()
@@ -163,4 +163,49 @@ fn obj_export_reproduces_the_geometry() {
         }
         assert_eq!(text.matches("# material ").count(), s.objects.len());
     }
+}
+
+#[test]
+fn normal_matrix_keeps_normals_perpendicular_under_shear_and_mirror() {
+    let linear = Mat3::from_cols(Vec3::new(2.0, 0.0, 0.0), Vec3::new(1.0, 0.5, 0.0), Vec3::new(0.0, 0.3, -3.0));
+    let n = normal_matrix(linear);
+    // a face spanned by u, v with normal u x v stays perpendicular to it when moved, on the
+    // same side of it (a mirror turns the winding, not the outside)
+    assert!(linear.determinant() < 0.0);
+    for (u, v) in [(Vec3::X, Vec3::Y), (Vec3::new(1.0, 2.0, 3.0), Vec3::new(-1.0, 0.5, 0.2))] {
+        let moved = -(linear * u).cross(linear * v);
+        let normal = n * u.cross(v);
+        assert!(moved.normalize().distance(normal.normalize()) < 1e-5, "{moved} vs {normal}");
+    }
+    assert_eq!(normal_matrix(Mat3::IDENTITY), Mat3::IDENTITY);
+    // flattened: no NaN
+    let flat = normal_matrix(Mat3::from_diagonal(Vec3::new(1.0, 0.0, 1.0)));
+    assert!(flat.is_finite());
+}
+
+#[test]
+fn a_mirrored_and_sheared_mesh_stays_valid_and_wound_from_outside() {
+    // a sphere moved by a shear and a mirror: still a valid mesh, its winding's normals point
+    // away from its centre as before (it stays convex), its shading normals agree in sign
+    let t = Affine3A::from_mat3(Mat3::from_cols(Vec3::new(-1.5, 0.0, 0.0), Vec3::new(0.7, 1.0, 0.0), Vec3::Z))
+        * Affine3A::from_translation(Vec3::new(0.5, -2.0, 3.0));
+    let mut sphere = Mesh::icosphere(Vec3::new(0.2, 1.0, -0.4), 0.8, 2);
+    let rest = sphere.clone();
+    sphere.transform(&t);
+    sphere.validate().unwrap_or_else(|e| panic!("{e}"));
+    let centre = t.transform_point3(Vec3::new(0.2, 1.0, -0.4));
+    let normals = sphere.normals.as_ref().unwrap();
+    for k in 0..sphere.indices.len() {
+        let g = sphere.geometric_normal(k);
+        let [a, b, c] = sphere.triangle(k);
+        assert!(g.dot((a + b + c) / 3.0 - centre) > 0.0, "triangle {k} winds inwards");
+        let i = sphere.indices[k][0] as usize;
+        assert!(normals[i].dot(g) > 0.0, "triangle {k}: shading normal against the winding");
+    }
+    // and back: the inverse restores the mesh
+    sphere.transform(&t.inverse());
+    for (p, q) in sphere.positions.iter().zip(&rest.positions) {
+        assert!(p.distance(*q) < 1e-4, "{p} vs {q}");
+    }
+    assert_eq!(sphere.indices, rest.indices);
 }

@@ -355,13 +355,13 @@ pub fn run(map: Option<&Path>, out: &Path, frames: usize, (w, h): (u32, u32)) ->
     let mut written = Vec::new();
     let rest = scene.objects[1].mesh.positions.clone();
     for frame in 0..frames {
-        // the box moves: the renderer rewrites its vertices, the maps' geometry takes them in place
+        // the box moves: the renderer rewrites its own vertices; the maps take the transform
         let t = frame as f32 / (frames.max(2) - 1) as f32;
         let moved = Mat4::from_translation(Vec3::new(-1.5 + 2.5 * t, 0.0, 0.8 * t));
         scene.objects[1].mesh.positions = rest.iter().map(|p| moved.transform_point3(*p)).collect();
         let first = meshes[0].positions.len() as u64 * std::mem::size_of::<Vertex>() as u64;
         queue.write_buffer(&vertex_buffer, first, bytemuck::cast_slice(&vertices_of(1, &scene.objects[1].mesh)));
-        maps.update_object(&gpu, &scene, 1)?;
+        maps.set_transform(&gpu, 1, glam::Affine3A::from_mat4(moved))?;
 
         // the renderer's G-buffer, and the toolkit's reduction of it, in one submission
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gbuffer") });

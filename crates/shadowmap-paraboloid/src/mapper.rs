@@ -438,7 +438,10 @@ impl ShadowMapper {
         let mut p = self.prepare(gpu, geometry, light, technique, settings, None)?;
         let (depth, args) = DepthCalls::of(geometry, &p);
         let calls = Calls::direct(args);
-        let (time, clock) = gpu.measure(|encoder| self.record_passes(encoder, geometry, &p, &depth, (&calls, 0)))?;
+        let (time, clock) = gpu.measure(|encoder| {
+            geometry.record_placement(gpu, encoder);
+            self.record_passes(encoder, geometry, &p, &depth, (&calls, 0));
+        })?;
         p.map.time = time;
         p.map.clock = clock;
         Ok(p.finish(depth.drawn))
@@ -485,6 +488,8 @@ impl ShadowMapper {
         (light, settings, stats): (&ShadowLight, &ShadowSettings, Option<&GpuStats>),
         (depth, calls, first): (DepthCalls, &Calls, usize),
     ) -> ShadowMap {
+        // moved objects' vertices first (nothing when none moved)
+        geometry.record_placement(gpu, encoder);
         let fit = match (p.map.technique, light, stats) {
             (Technique::Orthographic, ShadowLight::Distant { direction }, Some(stats)) if settings.focus.is_none() => {
                 Some(self.record_focus(gpu, encoder, geometry, *direction, settings.resolution, stats))

@@ -73,8 +73,10 @@ impl MapTechnique {
         settings: ShadowSettings,
         samples: u32,
     ) -> Result<Self, GpuError> {
-        let triangles = gpu::scene_triangles(scene);
-        let geometry = ShadowGeometry::upload(gpu, &triangles, ShadowGeometry::CHUNK_TRIANGLES)?;
+        let triangles: Vec<Vec<[Vec3; 3]>> =
+            scene.objects.iter().map(|o| (0..o.mesh.indices.len()).map(|t| o.mesh.triangle(t)).collect()).collect();
+        let objects: Vec<&[[Vec3; 3]]> = triangles.iter().map(Vec::as_slice).collect();
+        let geometry = ShadowGeometry::upload_objects(gpu, &objects, ShadowGeometry::CHUNK_TRIANGLES)?;
         let mut first = 0;
         let objects = scene
             .objects
@@ -124,6 +126,20 @@ impl MapTechnique {
         };
         let moved: Vec<[Vec3; 3]> = (0..count).map(|t| mesh.triangle(t)).collect();
         self.shared.geometry.borrow_mut().update(gpu, first, &moved)
+    }
+
+    /// Sets object `object`'s transform (from its mesh as this technique was made with, to the
+    /// world): a rigid (or any affine) motion without building anything, one
+    /// `queue.write_buffer`; the next depth pass places its vertices on the GPU. Every variant
+    /// sharing this one's geometry sees it.
+    ///
+    /// # Errors
+    /// [`GpuError::Failed`] for an object out of range or a non-finite transform.
+    pub fn set_transform(&self, gpu: &Gpu, object: usize, transform: glam::Affine3A) -> Result<(), GpuError> {
+        if object >= self.shared.objects.len() {
+            return Err(GpuError::Failed(format!("shadow maps: no object {object}")));
+        }
+        self.shared.geometry.borrow_mut().set_transform(gpu, object, transform)
     }
 
     /// The scratch targets for `size` images, `map` (resolution, layers) maps and an
@@ -197,7 +213,8 @@ impl ShadowTechnique for MapTechnique {
         let subdivided;
         let geometry = shared.geometry.borrow();
         let geometry = if self.technique == Technique::DualParaboloid && settings.subdivide_angle.is_some() {
-            let t = shadow_triangles(geometry.triangle_soup(), &lights[0], self.technique, &settings);
+            let soup = geometry.triangle_soup();
+            let t = shadow_triangles(&soup, &lights[0], self.technique, &settings);
             subdivided = ShadowGeometry::upload(gpu, &t, ShadowGeometry::CHUNK_TRIANGLES)?;
             &subdivided
         } else {
