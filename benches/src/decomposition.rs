@@ -91,10 +91,6 @@ pub struct Frame {
     /// The scene as built (objects at rest; [`Frame::set_transform`] moves them), its camera
     /// at the frame's size.
     pub scene: scene::Scene,
-    // per object, where it is: its transform from rest
-    poses: Vec<glam::Affine3A>,
-    // per object, the box around its finite vertices at rest
-    object_boxes: Vec<Option<(glam::Vec3, glam::Vec3)>>,
     /// The decomposition of the default map, EnvDirects first.
     pub decomposition: Decomposition,
     geometry: SceneGeometry,
@@ -107,8 +103,6 @@ pub struct Frame {
     maps: MapTechnique,
     // the receivers of the full- and the low-resolution G-buffer
     reductions: [ReceiverReduction; 2],
-    // the box around every vertex at the current poses, made when an object moves, not per frame
-    scene_box: Option<(glam::Vec3, glam::Vec3)>,
 }
 
 impl Frame {
@@ -142,9 +136,6 @@ impl Frame {
             wedges: Wedges::new(gpu, &scene, WedgeSettings::default()),
             maps: MapTechnique::new(gpu, &scene, Technique::Orthographic, maps_settings(), 1).map_err(e)?,
             reductions: [ReceiverReduction::new(gpu), ReceiverReduction::new(gpu)],
-            scene_box: scene_bounds(&scene),
-            poses: vec![glam::Affine3A::IDENTITY; scene.objects.len()],
-            object_boxes: scene.objects.iter().map(|o| finite_box(&o.mesh.positions)).collect(),
             scene,
             decomposition,
         })
@@ -157,26 +148,9 @@ impl Frame {
     /// # Errors
     /// An object index out of range; a non-finite transform.
     pub fn set_transform(&mut self, gpu: &Gpu, object: usize, transform: glam::Affine3A) -> Result<(), GpuError> {
-        if object >= self.poses.len() {
-            return Err(GpuError::Failed(format!("no object {object}")));
-        }
         self.geometry.set_transform(gpu, object, transform)?;
         self.wedges.set_transform(gpu, object, transform)?;
-        self.maps.set_transform(gpu, object, transform)?;
-        self.poses[object] = transform;
-        let boxes = self
-            .object_boxes
-            .iter()
-            .zip(&self.poses)
-            .filter_map(|(b, t)| Some(gpu::placement::transform_box(t, (*b)?)));
-        self.scene_box = boxes.reduce(|(a, b), (c, d)| (a.min(c), b.max(d)));
-        Ok(())
-    }
-
-    /// The scene as built, before any object moved (what [`Frame::set_transform`] moves from).
-    #[must_use]
-    pub fn rest(&self) -> &scene::Scene {
-        &self.scene
+        self.maps.set_transform(gpu, object, transform)
     }
 
     /// The scene with every object's vertices where its transform puts them: what a frame
@@ -184,8 +158,8 @@ impl Frame {
     #[must_use]
     pub fn posed_scene(&self) -> scene::Scene {
         let mut posed = self.scene.clone();
-        for (o, t) in posed.objects.iter_mut().zip(&self.poses) {
-            o.mesh.transform(t);
+        for (k, o) in posed.objects.iter_mut().enumerate() {
+            o.mesh.transform(&self.geometry.transform(k));
         }
         posed
     }
@@ -217,7 +191,9 @@ impl Frame {
         let settings = SplitSettings { indirect_scale: scale, upsample: JointBilateral::PAPER };
         let low_camera = indirect_camera(&self.scene.camera, &settings)?;
         let (gb, low_gb, pending) = self.submit_reduced(gpu, &lights, &shapes, &low_camera, scale)?;
-        let scene_box = self.scene_box;
+        // the drawn geometry's box, its objects where their transforms put them
+        let (lo, hi) = self.geometry.bounds;
+        let scene_box = (lo.is_finite() && hi.is_finite()).then_some((lo, hi));
         let directs = d.directs() as u32;
         let bounds = scene_box.and_then(|b| gpu::conservative_bounds(b, &gb.view));
         let receivers = Receivers::on_gpu(&gb, bounds, pending[0].on_gpu().clone());
@@ -367,11 +343,6 @@ impl Frame {
         gpu.wait(None)?;
         Ok((start.elapsed(), texture))
     }
-}
-
-/// The box around every finite vertex of `scene`'s objects, `None` for none.
-fn scene_bounds(scene: &scene::Scene) -> Option<(glam::Vec3, glam::Vec3)> {
-    finite_box(scene.objects.iter().flat_map(|o| &o.mesh.positions))
 }
 
 /// The box around the finite points of `points`, `None` for none.

@@ -76,7 +76,7 @@ fn a_moving_object_frame_equals_a_frame_built_for_its_pose() {
     let at_rest = image(&frame, 2);
     let object = animated_object(&frame.scene);
     // turned and moved: the placement's rotation of positions and normals, not only a shift
-    frame.set_transform(&gpu, object, animation_pose(frame.rest(), object, 5)).unwrap();
+    frame.set_transform(&gpu, object, animation_pose(&frame.scene, object, 5)).unwrap();
     // a frame after the first costs two submissions, no wait and no pipeline
     let before = gpu.counters();
     let rendered = frame.render(&gpu, 2).unwrap();

@@ -63,7 +63,7 @@ pub fn run(args: &FrameArgs) -> Result<(), String> {
         let mut last = None;
         let stats = measure_frames(&gpu, args.repeats, |k| -> Result<(), gpu::GpuError> {
             if let Some(object) = moving {
-                frame.set_transform(&gpu, object, animation_pose(frame.rest(), object, k))?;
+                frame.set_transform(&gpu, object, animation_pose(&frame.scene, object, k))?;
             }
             last = Some(frame.render(&gpu, scale)?);
             Ok(())
@@ -77,7 +77,7 @@ pub fn run(args: &FrameArgs) -> Result<(), String> {
         // what the last frame skipped and why
         let skipped = gpu::skip_reasons(&reports);
         if args.json {
-            let mut v = json(args, &gpu, &stats, moving.map(|k| frame.rest().objects[k].name.as_str()), lights);
+            let mut v = json(args, &gpu, &stats, moving.map(|k| frame.scene.objects[k].name.as_str()), lights);
             v["lights_shadowed"] = (reports.len() - skipped.iter().map(|(_, n)| n).sum::<usize>()).into();
             v["lights_skipped"] = skipped.iter().map(|(why, n)| serde_json::json!({"why": why, "lights": n})).collect();
             outln!("{v}");
