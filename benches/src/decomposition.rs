@@ -6,14 +6,16 @@
 
 use envmap_sphere::EnvMap;
 use gpu::{
-    Background, GBufferPass, Gpu, GpuError, JointBilateral, LightShape, MappedStats, PendingStats, PrefilterSettings,
-    ReceiverReduction, Receivers, SceneGeometry, ShadeLight, ShadingPass, ShadowTechnique, SpecularAmbient, SplitFrame,
-    SplitPasses, SplitSettings, UpsamplePass, Visibility, WEBER_FRACTION, WeberInput, indirect_camera, record_split,
-    record_visibility,
+    Background, GBufferPass, GBufferTargets, Gpu, GpuError, JointBilateral, LightShape, MappedStats, PendingStats,
+    PrefilterSettings, ReceiverReduction, Receivers, SceneGeometry, ShadeLight, ShadingPass, ShadowTechnique,
+    SpecularAmbient, SplitFrame, SplitPasses, SplitSettings, UpsamplePass, Visibility, WEBER_FRACTION, WeberInput,
+    indirect_camera, record_split, record_visibility,
 };
 use light_extract::Decomposition;
 use penumbra_wedge::{WedgeSettings, Wedges};
 use shadowmap_paraboloid::{MapTechnique, ShadowSettings, Technique};
+use std::cell::RefCell;
+use std::rc::Rc;
 use std::time::{Duration, Instant};
 
 /// The extraction the frame draws: the toolkit's most accurate (validate's default).
@@ -103,6 +105,11 @@ pub struct Frame {
     maps: MapTechnique,
     // the receivers of the full- and the low-resolution G-buffer
     reductions: [ReceiverReduction; 2],
+    // what the frame renders into, made once: the full-resolution G-buffer, the low one (for
+    // the last scale asked) and the EnvDirects' visibility
+    targets: GBufferTargets,
+    low_targets: RefCell<Option<(u32, Rc<GBufferTargets>)>>,
+    direct_visibility: Visibility,
 }
 
 impl Frame {
@@ -126,7 +133,11 @@ impl Frame {
         let extractor = light_extract::extractor(METHOD, lights).ok_or("unknown method")?;
         let mut decomposition = extractor.extract(map).map_err(|e| e.to_string())?;
         decomposition.sort_directs_first();
+        let size = (scene.camera.width, scene.camera.height);
         Ok(Self {
+            targets: GBufferTargets::new(gpu, size).map_err(e)?,
+            low_targets: RefCell::new(None),
+            direct_visibility: Visibility::allocate(gpu, size.0, size.1, decomposition.directs() as u32).map_err(e)?,
             geometry: SceneGeometry::upload(gpu, &scene).map_err(e)?,
             gbuffer: GBufferPass::new(gpu),
             shading: ShadingPass::new(gpu).map_err(e)?,
@@ -253,15 +264,32 @@ impl Frame {
         let ambient = Some(&self.decomposition.ambient_sh);
         let weber = WeberInput { lights, ambient, fraction: WEBER_FRACTION };
         let mut encoder = gpu.encoder("frame g-buffers");
-        let gb = self.gbuffer.record(gpu, &mut encoder, &self.geometry, &self.scene.camera)?;
-        let low_gb =
-            (scale != 1).then(|| self.gbuffer.record(gpu, &mut encoder, &self.geometry, low_camera)).transpose()?;
+        let view = GBufferPass::camera_view(&self.geometry, &self.scene.camera);
+        let gb = self.gbuffer.record_into(gpu, &mut encoder, &self.geometry, &view, &self.targets)?;
+        let low_gb = if scale == 1 {
+            None
+        } else {
+            let low = self.low_targets(gpu, scale, (low_camera.width, low_camera.height))?;
+            let view = GBufferPass::camera_view(&self.geometry, low_camera);
+            Some(self.gbuffer.record_into(gpu, &mut encoder, &self.geometry, &view, &low)?)
+        };
         let mut pending = vec![self.reductions[0].record(gpu, &mut encoder, &gb, shapes, Some(weber))?];
         if let Some(l) = &low_gb {
             pending.push(self.reductions[1].record(gpu, &mut encoder, l, shapes, Some(weber))?);
         }
         gpu.submit(encoder);
         Ok((gb, low_gb, pending))
+    }
+
+    /// The low-resolution G-buffer's targets for `scale`, made when the scale changes.
+    fn low_targets(&self, gpu: &Gpu, scale: u32, size: (u32, u32)) -> Result<Rc<GBufferTargets>, GpuError> {
+        let mut low = self.low_targets.borrow_mut();
+        if let Some((_, t)) = low.as_ref().filter(|(s, _)| *s == scale) {
+            return Ok(t.clone());
+        }
+        let t = Rc::new(GBufferTargets::new(gpu, size)?);
+        *low = Some((scale, t.clone()));
+        Ok(t)
     }
 
     /// The same frame with its receivers made on the CPU from the G-buffers' points mapped back
@@ -303,19 +331,18 @@ impl Frame {
     ) -> Result<RenderedFrame, GpuError> {
         let d = &self.decomposition;
         let directs = d.directs();
-        let (w, h) = receivers.gbuffer.size();
-        let vis = Visibility::allocate(gpu, w, h, directs as u32)?;
+        let vis = &self.direct_visibility;
         vis.record_clear(encoder);
         let wedges: &dyn ShadowTechnique = &self.wedges;
         let direct_negligible = negligible.get(..directs).unwrap_or(&[]);
         let mut reports =
-            record_visibility(gpu, encoder, wedges, receivers, &shapes[..directs], direct_negligible, &vis)?;
+            record_visibility(gpu, encoder, wedges, receivers, &shapes[..directs], direct_negligible, vis)?;
         let split = record_split(
             gpu,
             encoder,
             &SplitPasses { gbuffer: &self.gbuffer, shading: &self.shading, upsample: &self.upsample },
             &self.geometry,
-            (receivers, &vis),
+            (receivers, vis),
             low,
             &SplitFrame {
                 lights,

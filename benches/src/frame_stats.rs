@@ -1,5 +1,6 @@
 //! What a frame costs, counted over many frames: queue submissions, CPU waits, bytes mapped
-//! back, pipelines created after the first frame, gate passes (from `gpu::GpuCounters`), the CPU's time
+//! back, pipelines created after the first frame, gate passes, buffers, bind groups and textures
+//! created (from `gpu::GpuCounters`), the CPU's time
 //! outside waits, GPU time between two timestamps around the frame, and wall time.
 //!
 //! The measurement wraps the frame: the timestamps go in submissions of their own before and
@@ -26,6 +27,9 @@ pub struct FrameStats {
     pub pipelines_created_after_first_frame: u64,
     /// Gate passes recorded (one a gated light and technique).
     pub gate_passes_per_frame: f64,
+    /// Buffers, bind groups and textures the toolkit created ([`gpu::Gpu::create_buffer`] and
+    /// its siblings): what a frame still makes instead of reusing.
+    pub created_per_frame: Created,
     /// CPU time outside waits: recording, planning, uploads.
     pub cpu_record_ms: f64,
     /// GPU time from the frame's first command to its last (timestamps), `None` without
@@ -33,6 +37,17 @@ pub struct FrameStats {
     pub gpu_ms: Option<f64>,
     /// Wall time until the frame's work is done.
     pub wall_ms: f64,
+}
+
+/// Resources created in a frame (medians).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Created {
+    /// Buffers.
+    pub buffers: f64,
+    /// Bind groups.
+    pub bind_groups: f64,
+    /// Textures.
+    pub textures: f64,
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -62,7 +77,7 @@ impl Stamps {
             count: 2,
         });
         let buffer = |label, usage| {
-            gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            gpu.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
                 size: 16,
                 usage,
@@ -107,6 +122,7 @@ pub fn measure_frames<E: From<GpuError>>(
     let (mut submits, mut waits, mut bytes, mut cpu, mut gpu_ms, mut wall) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut gates = Vec::new();
+    let (mut buffers, mut binds, mut textures) = (Vec::new(), Vec::new(), Vec::new());
     let mut pipelines_after_first = 0;
     for k in 0..=frames {
         if let Some(s) = &stamps {
@@ -130,6 +146,9 @@ pub fn measure_frames<E: From<GpuError>>(
         waits.push(d.waits as f64);
         bytes.push(d.readback_bytes as f64);
         gates.push(d.gate_passes as f64);
+        buffers.push(d.buffers as f64);
+        binds.push(d.bind_groups as f64);
+        textures.push(d.textures as f64);
         cpu.push(elapsed.saturating_sub(Duration::from_nanos(d.wait_ns)).as_secs_f64() * 1e3);
         wall.push(elapsed.as_secs_f64() * 1e3);
         gpu_ms.extend(ms);
@@ -141,6 +160,7 @@ pub fn measure_frames<E: From<GpuError>>(
         readback_bytes_per_frame: median(bytes),
         pipelines_created_after_first_frame: pipelines_after_first,
         gate_passes_per_frame: median(gates),
+        created_per_frame: Created { buffers: median(buffers), bind_groups: median(binds), textures: median(textures) },
         cpu_record_ms: median(cpu),
         gpu_ms: (!gpu_ms.is_empty()).then(|| median(gpu_ms)),
         wall_ms: median(wall),

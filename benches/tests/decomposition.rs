@@ -144,3 +144,28 @@ fn the_gated_frame_skips_the_lights_the_waited_frame_skips_and_draws_the_same_im
         assert!(flip <= 1e-3 && rmse <= 1e-3, "scale {scale}: FLIP {flip}, RMSE {rmse}, {differ} pixels differ");
     }
 }
+
+#[test]
+fn after_the_first_frame_no_resource_is_made_per_light() {
+    // per-light uniforms and bind groups live in slots reused from frame to frame: what a
+    // moving frame still makes (per frame: its output images and a few per-pass uniforms) does
+    // not grow with its lights, and the lights' own passes make nothing
+    let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
+    let map = envmap_sphere::default_map();
+    let created = |lights: usize| {
+        let mut frame = Frame::new(&gpu, "spheres_box", (96, 72), &map, lights).unwrap_or_else(|e| panic!("{e}"));
+        let object = envshadow_benches::decomposition::animated_object(&frame.scene);
+        let stats = envshadow_benches::frame_stats::measure_frames(&gpu, 3, |k| -> Result<(), gpu::GpuError> {
+            let pose = envshadow_benches::decomposition::animation_pose(&frame.scene, object, k + 1);
+            frame.set_transform(&gpu, object, pose)?;
+            frame.render(&gpu, 2).map(|_| ())
+        })
+        .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(stats.pipelines_created_after_first_frame, 0, "{lights} lights");
+        stats.created_per_frame
+    };
+    let (few, many) = (created(4), created(32));
+    assert_eq!(few, many, "4 lights made {few:?} a frame, 32 made {many:?}");
+    // the frame's own: 4 images (2 shaded, their upsampling, the EnvIndirects' visibility)
+    assert!(many.textures <= 4.0 && many.buffers <= 24.0 && many.bind_groups <= 24.0, "{many:?}");
+}

@@ -18,7 +18,6 @@ use glam::Vec3;
 use gpu::{GBuffer, GBufferPass, Gpu, GpuError, SceneGeometry, ShadowGeometry};
 use shadowmap_paraboloid::{DEPTH_FORMAT, ShadowLight, ShadowMapper, ShadowSettings, Technique};
 use shaft_hierarchy::preprocess::{Origin, Source};
-use wgpu::util::DeviceExt;
 
 use crate::compositor::{Compositor, Frame, RepTransfer};
 use crate::{Mode, SyntheticObject};
@@ -165,7 +164,7 @@ impl GpuCompositor {
         let (w, h) = c.size;
         gpu.check_texture(w, h, 1)?;
         let storage = |label: &str, bytes: &[u8], extra: wgpu::BufferUsages| {
-            gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(label),
                 contents: bytes,
                 usage: wgpu::BufferUsages::STORAGE | extra,
@@ -200,13 +199,13 @@ impl GpuCompositor {
             pixels: storage("composite pixels", bytemuck::cast_slice(&table), wgpu::BufferUsages::empty()),
             photo_hdr: storage("photo hdr", bytemuck::cast_slice(&hdr), wgpu::BufferUsages::empty()),
             photo_ldr: storage("photo ldr", bytemuck::cast_slice(&ldr), wgpu::BufferUsages::empty()),
-            darkening: gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            darkening: gpu.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("darkening"),
                 size: n * 16,
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }),
-            out: gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            out: gpu.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("composite"),
                 size: n * 4,
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
@@ -413,7 +412,7 @@ impl GpuCompositor {
             transfers.push([0.0; 4]);
         }
         let buffer = |label, contents: &[u8], usage| {
-            gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+            gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
         };
         let transfer_buffer = buffer("transfers", bytemuck::cast_slice(&transfers), wgpu::BufferUsages::STORAGE);
         encoder.clear_buffer(&self.darkening, 0, None);
@@ -435,7 +434,7 @@ impl GpuCompositor {
                 aspect: wgpu::TextureAspect::DepthOnly,
                 ..Default::default()
             });
-            let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            let bind = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("composite masks"),
                 layout: &self.masks.get_bind_group_layout(0),
                 entries: &[
@@ -480,14 +479,14 @@ impl GpuCompositor {
             albedo: (object.albedo / std::f32::consts::PI).extend(0.0).to_array(),
             irradiance,
         };
-        let uniform = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        let uniform = gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("resolve params"),
             contents: bytemuck::bytes_of(&params),
             usage: wgpu::BufferUsages::UNIFORM,
         });
         let position = gb.position.create_view(&wgpu::TextureViewDescriptor::default());
         let normal = gb.normal.create_view(&wgpu::TextureViewDescriptor::default());
-        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let bind = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("resolve"),
             layout: &self.resolve.get_bind_group_layout(0),
             entries: &[

@@ -8,7 +8,6 @@
 
 use crate::context::{Gpu, GpuError};
 use crate::gbuffer::GBuffer;
-use wgpu::util::DeviceExt;
 
 /// Blend state adding a pass's output to what the accumulator holds.
 pub const ADD: wgpu::BlendState = wgpu::BlendState {
@@ -86,6 +85,14 @@ impl Accumulator {
 /// their shader.
 pub struct ResolvePass {
     pipeline: wgpu::RenderPipeline,
+    // each light's parameters and bind group, kept from frame to frame
+    slots: crate::Slots<ResolveSlot>,
+}
+
+/// One light's resolve: its uniform and the bind group over it and the textures it reads.
+struct ResolveSlot {
+    params: wgpu::Buffer,
+    bind: crate::Keyed<Vec<wgpu::Texture>, wgpu::BindGroup>,
 }
 
 impl ResolvePass {
@@ -100,12 +107,20 @@ impl ResolvePass {
     #[must_use]
     pub fn with_shader(gpu: &Gpu, label: &str, source: &str, library: &[(&str, &str)]) -> Self {
         let module = crate::shader::module(&gpu.device, label, source, library);
-        Self { pipeline: crate::fullscreen::pipeline(gpu, label, &module, crate::shade::Visibility::FORMAT) }
+        Self {
+            pipeline: crate::fullscreen::pipeline(gpu, label, &module, crate::shade::Visibility::FORMAT),
+            slots: crate::Slots::new(),
+        }
     }
 
     /// Records the resolve of `acc` into `target` (a visibility layer): `params` is the
-    /// uniform at binding 0, `extra` any further bindings the shader reads; `call`: the
-    /// triangle as call `k` of a light's [`crate::Calls`] (gated), or `None` to draw it.
+    /// uniform at binding 0 (at most 256 bytes), `extra` the textures of further bindings the
+    /// shader reads (whole, as their default views); `call`: the triangle as call `k` of a
+    /// light's [`crate::Calls`] (gated), or `None` to draw it. Each light of a submission keeps
+    /// its uniform and bind group from frame to frame ([`crate::Slots`]).
+    ///
+    /// # Errors
+    /// [`GpuError::TooLarge`] for parameters over 256 bytes.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
@@ -114,35 +129,60 @@ impl ResolvePass {
         gbuffer: &GBuffer,
         acc: &Accumulator,
         params: &[u8],
-        extra: &[(u32, wgpu::BindingResource<'_>)],
+        extra: &[(u32, &wgpu::Texture)],
         call: Option<(&crate::Calls, usize)>,
         target: &wgpu::TextureView,
-    ) {
-        let buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("resolve"),
-            contents: params,
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let position = gbuffer.position.create_view(&Default::default());
-        let mut entries = vec![
-            wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&position) },
-            wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&acc.view) },
-        ];
-        entries.extend(
-            extra
-                .iter()
-                .map(|(binding, resource)| wgpu::BindGroupEntry { binding: *binding, resource: resource.clone() }),
-        );
-        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("resolve"),
-            layout: &self.pipeline.get_bind_group_layout(0),
-            entries: &entries,
-        });
+    ) -> Result<(), GpuError> {
+        const PARAMS: u64 = 256;
+        if params.len() as u64 > PARAMS || !params.len().is_multiple_of(4) {
+            return Err(GpuError::TooLarge {
+                what: "resolve parameter bytes",
+                size: params.len() as u64,
+                limit: PARAMS,
+            });
+        }
+        let make = || {
+            Ok(ResolveSlot {
+                params: gpu.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("resolve"),
+                    size: PARAMS,
+                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                }),
+                bind: crate::Keyed::default(),
+            })
+        };
+        let bind = self.slots.next(gpu, make, |slot| {
+            gpu.queue.write_buffer(&slot.params, 0, params);
+            let key: Vec<wgpu::Texture> =
+                [&gbuffer.position, &acc.texture].into_iter().chain(extra.iter().map(|(_, t)| *t)).cloned().collect();
+            let buffer = slot.params.clone();
+            let bind = slot.bind.get(key, || {
+                let views: Vec<wgpu::TextureView> =
+                    extra.iter().map(|(_, t)| t.create_view(&Default::default())).collect();
+                let position = gbuffer.position.create_view(&Default::default());
+                let mut entries = vec![
+                    wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&position) },
+                    wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&acc.view) },
+                ];
+                entries.extend(extra.iter().zip(&views).map(|((binding, _), view)| wgpu::BindGroupEntry {
+                    binding: *binding,
+                    resource: wgpu::BindingResource::TextureView(view),
+                }));
+                Ok(gpu.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("resolve"),
+                    layout: &self.pipeline.get_bind_group_layout(0),
+                    entries: &entries,
+                }))
+            })?;
+            Ok(bind.clone())
+        })?;
         let clear = wgpu::LoadOp::Clear(wgpu::Color::WHITE);
         match call {
             Some(call) => crate::fullscreen::record_calls(encoder, &self.pipeline, &bind, target, clear, call),
             None => crate::fullscreen::record(encoder, &self.pipeline, &bind, target, clear),
         }
+        Ok(())
     }
 }

@@ -81,6 +81,13 @@ pub struct GpuCounters {
     pub wait_ns: u64,
     /// Gate passes recorded ([`crate::Gate`]): one a gated light per technique call.
     pub gate_passes: u64,
+    /// Buffers created through [`Gpu::create_buffer`] and [`Gpu::create_buffer_init`] (every
+    /// buffer the toolkit's library crates make).
+    pub buffers: u64,
+    /// Bind groups created through [`Gpu::create_bind_group`].
+    pub bind_groups: u64,
+    /// Textures created through [`Gpu::create_texture`].
+    pub textures: u64,
 }
 
 /// What happened between two snapshots, `later - earlier` (saturating: never negative).
@@ -94,6 +101,9 @@ impl std::ops::Sub for GpuCounters {
             pipelines: self.pipelines.saturating_sub(o.pipelines),
             wait_ns: self.wait_ns.saturating_sub(o.wait_ns),
             gate_passes: self.gate_passes.saturating_sub(o.gate_passes),
+            buffers: self.buffers.saturating_sub(o.buffers),
+            bind_groups: self.bind_groups.saturating_sub(o.bind_groups),
+            textures: self.textures.saturating_sub(o.textures),
         }
     }
 }
@@ -106,6 +116,11 @@ struct Counters {
     pipelines: AtomicU64,
     wait_ns: AtomicU64,
     gate_passes: AtomicU64,
+    buffers: AtomicU64,
+    bind_groups: AtomicU64,
+    textures: AtomicU64,
+    // submissions made or marked ([`Gpu::mark_submitted`]): where per-light slots start over
+    epoch: AtomicU64,
 }
 
 /// The environment variable [`Gpu::new`] reads an adapter name from (as `--adapter`).
@@ -265,7 +280,54 @@ impl Gpu {
             pipelines: c.pipelines.load(Ordering::Relaxed),
             wait_ns: c.wait_ns.load(Ordering::Relaxed),
             gate_passes: c.gate_passes.load(Ordering::Relaxed),
+            buffers: c.buffers.load(Ordering::Relaxed),
+            bind_groups: c.bind_groups.load(Ordering::Relaxed),
+            textures: c.textures.load(Ordering::Relaxed),
         }
+    }
+
+    /// Submissions made through [`Gpu::submit`] or marked by [`Gpu::mark_submitted`]: per-light
+    /// resources ([`crate::Slots`]) start over when it changes.
+    #[must_use]
+    pub fn epoch(&self) -> u64 {
+        self.counters.epoch.load(Ordering::Relaxed)
+    }
+
+    /// Tells the toolkit that what was recorded so far has been submitted, for callers that
+    /// submit through their own `queue.submit` (with other command buffers of theirs): the
+    /// techniques' per-light uniforms ([`crate::Slots`]) are then reused by the next frame
+    /// instead of new ones being made. [`Gpu::submit`] does this itself.
+    pub fn mark_submitted(&self) {
+        self.counters.epoch.fetch_add(1, Ordering::Relaxed);
+    }
+
+    /// Creates a buffer (counted in [`GpuCounters::buffers`]).
+    #[must_use]
+    pub fn create_buffer(&self, descriptor: &wgpu::BufferDescriptor) -> wgpu::Buffer {
+        self.counters.buffers.fetch_add(1, Ordering::Relaxed);
+        self.device.create_buffer(descriptor)
+    }
+
+    /// Creates a buffer holding `descriptor.contents` (counted in [`GpuCounters::buffers`]).
+    #[must_use]
+    pub fn create_buffer_init(&self, descriptor: &wgpu::util::BufferInitDescriptor) -> wgpu::Buffer {
+        use wgpu::util::DeviceExt;
+        self.counters.buffers.fetch_add(1, Ordering::Relaxed);
+        self.device.create_buffer_init(descriptor)
+    }
+
+    /// Creates a bind group (counted in [`GpuCounters::bind_groups`]).
+    #[must_use]
+    pub fn create_bind_group(&self, descriptor: &wgpu::BindGroupDescriptor) -> wgpu::BindGroup {
+        self.counters.bind_groups.fetch_add(1, Ordering::Relaxed);
+        self.device.create_bind_group(descriptor)
+    }
+
+    /// Creates a texture (counted in [`GpuCounters::textures`]).
+    #[must_use]
+    pub fn create_texture(&self, descriptor: &wgpu::TextureDescriptor) -> wgpu::Texture {
+        self.counters.textures.fetch_add(1, Ordering::Relaxed);
+        self.device.create_texture(descriptor)
     }
 
     /// Counts a gate pass recorded.
@@ -276,7 +338,9 @@ impl Gpu {
     /// Submits `encoder` without waiting.
     pub fn submit(&self, encoder: wgpu::CommandEncoder) -> wgpu::SubmissionIndex {
         self.counters.submits.fetch_add(1, Ordering::Relaxed);
-        self.queue.submit([encoder.finish()])
+        let index = self.queue.submit([encoder.finish()]);
+        self.mark_submitted();
+        index
     }
 
     /// Blocks until the queue has finished `index` (or everything submitted, for `None`).

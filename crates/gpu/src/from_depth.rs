@@ -5,7 +5,6 @@
 use crate::context::{Gpu, GpuError};
 use crate::gbuffer::{GBUFFER_FORMAT, GBuffer};
 use crate::view::View;
-use wgpu::util::DeviceExt;
 
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -85,14 +84,14 @@ impl DepthGBufferPass {
             toward_viewer: view.toward_viewer().to_array(),
             info: [view.far_depth(), w as f32, h as f32, 0.0],
         };
-        let buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        let buffer = gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("gbuffer from depth"),
             contents: bytemuck::bytes_of(&params),
             usage: wgpu::BufferUsages::UNIFORM,
         });
         let depth_view = depth
             .create_view(&wgpu::TextureViewDescriptor { aspect: wgpu::TextureAspect::DepthOnly, ..Default::default() });
-        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let bind = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gbuffer from depth"),
             layout: &self.pipeline.get_bind_group_layout(0),
             entries: &[

@@ -7,7 +7,6 @@
 
 use crate::context::Gpu;
 use std::ops::Range;
-use wgpu::util::DeviceExt;
 
 /// A reduction's result left on the GPU: what gates lights and what techniques that fit their
 /// work to the receivers (orthographic maps' focus) read, without a readback.
@@ -17,6 +16,17 @@ pub struct GpuStats {
     pub(crate) weber: Option<wgpu::Buffer>,
     pub(crate) gate: wgpu::ComputePipeline,
     pub(crate) first: u32,
+    // each gated light's arguments, parameters and bind group, kept from frame to frame
+    pub(crate) slots: std::sync::Arc<crate::Slots<GateSlot>>,
+}
+
+/// One gated light's resources ([`crate::Slots`]): its argument words (grown to the most a
+/// light has used), its parameters and the bind group over them and the reduction's buffers.
+#[derive(Debug)]
+pub(crate) struct GateSlot {
+    args: wgpu::Buffer,
+    params: wgpu::Buffer,
+    bind: crate::Keyed<(wgpu::Buffer, wgpu::Buffer, wgpu::Buffer), wgpu::BindGroup>,
 }
 
 impl GpuStats {
@@ -160,27 +170,54 @@ impl Gate<'_> {
             // storage bindings may not be empty
             words.push(0);
         }
-        let buffer = |label, contents: &[u8], usage| {
-            gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
-        };
-        let args = buffer(
-            "gated arguments",
-            bytemuck::cast_slice(&words),
-            wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::STORAGE,
-        );
         let params = [self.light, words.len() as u32, u32::from(self.stats.weber.is_some()), 0];
-        let params = buffer("gate", bytemuck::cast_slice(&params), wgpu::BufferUsages::UNIFORM);
         let weber = self.stats.weber.as_ref().unwrap_or(&self.stats.stats);
-        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("gate"),
-            layout: &self.stats.gate.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: self.stats.stats.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: weber.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: args.as_entire_binding() },
-            ],
-        });
+        let bytes = 4 * words.len() as u64;
+        let make = || {
+            let buffer = |label, size, usage| {
+                gpu.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size,
+                    usage,
+                    mapped_at_creation: false,
+                })
+            };
+            let usage = wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
+            // room for a few more calls than the first light had: later ones rarely grow it
+            let args = buffer("gated arguments", bytes.max(256), usage);
+            let params = buffer("gate", 16, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
+            Ok(GateSlot { args, params, bind: crate::Keyed::default() })
+        };
+        let fill = |slot: &mut GateSlot| {
+            if slot.args.size() < bytes {
+                *slot = make()?;
+            }
+            gpu.queue.write_buffer(&slot.args, 0, bytemuck::cast_slice(&words));
+            gpu.queue.write_buffer(&slot.params, 0, bytemuck::cast_slice(&params));
+            let key = (slot.args.clone(), self.stats.stats.clone(), weber.clone());
+            let (args, params) = (slot.args.clone(), slot.params.clone());
+            let bind = slot.bind.get(key, || {
+                Ok(gpu.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("gate"),
+                    layout: &self.stats.gate.get_bind_group_layout(0),
+                    entries: &[
+                        wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 1, resource: self.stats.stats.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 2, resource: weber.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 3, resource: args.as_entire_binding() },
+                    ],
+                }))
+            })?;
+            Ok((args, bind.clone()))
+        };
+        // past the slots a submission may hold, a light's own resources (made for it alone)
+        let (args, bind) = match self.stats.slots.next(gpu, make, fill) {
+            Ok(kept) => kept,
+            Err(_) => {
+                let mut own = make().expect("making buffers does not fail");
+                fill(&mut own).expect("a new slot is large enough")
+            }
+        };
         gpu.count_gate_pass();
         let mut pass =
             encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("gate"), timestamp_writes: None });

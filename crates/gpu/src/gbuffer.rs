@@ -4,7 +4,6 @@
 use crate::context::{Gpu, GpuError};
 use crate::geometry::SceneGeometry;
 use glam::{Mat4, Vec3};
-use wgpu::util::DeviceExt;
 
 /// Format of the G-buffer's colour targets.
 pub const GBUFFER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
@@ -174,10 +173,17 @@ impl GBufferPass {
         geometry: &SceneGeometry,
         camera: &scene::Camera,
     ) -> Result<GBuffer, GpuError> {
+        self.record_view(gpu, encoder, geometry, &Self::camera_view(geometry, camera))
+    }
+
+    /// The view [`GBufferPass::record`] renders `camera` from: an infinite reversed depth whose
+    /// near plane scales with the scene's reach from the eye.
+    #[must_use]
+    pub fn camera_view(geometry: &SceneGeometry, camera: &scene::Camera) -> crate::View {
         let (lo, hi) = geometry.bounds;
         let reach = if lo.is_finite() { (hi - lo).length() + camera.eye.distance(0.5 * (lo + hi)) } else { 1.0 };
         let near = (reach * 1e-6).max(f32::MIN_POSITIVE * 1e6);
-        self.record_view(gpu, encoder, geometry, &crate::View::from_camera(camera, near))
+        crate::View::from_camera(camera, near)
     }
 
     /// Records the G-buffer pass of `geometry` seen from `view` (any projection in wgpu's clip
@@ -192,26 +198,45 @@ impl GBufferPass {
         geometry: &SceneGeometry,
         view: &crate::View,
     ) -> Result<GBuffer, GpuError> {
+        let targets = GBufferTargets::new(gpu, view.size())?;
+        self.record_into(gpu, encoder, geometry, view, &targets)
+    }
+
+    /// Records the G-buffer pass of `geometry` seen from `view` into `targets` (made once for
+    /// the view's size and rendered into frame after frame: no texture, buffer or bind group
+    /// is made): the returned G-buffer shares their textures. The view goes to their camera
+    /// uniform with `queue.write_buffer`, so targets hold one view a submission.
+    ///
+    /// # Errors
+    /// [`GpuError::Failed`] for targets of another size than the view.
+    pub fn record_into(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        geometry: &SceneGeometry,
+        view: &crate::View,
+        targets: &GBufferTargets,
+    ) -> Result<GBuffer, GpuError> {
+        if targets.size != view.size() {
+            return Err(GpuError::Failed(format!(
+                "G-buffer targets of {:?} for a view of {:?}",
+                targets.size,
+                view.size()
+            )));
+        }
         geometry.record_placement(gpu, encoder);
-        let (w, h) = view.size();
-        let size = (w, h, 1);
-        let target = |label, format| crate::target::render_target(gpu, label, size, format);
         let gb = GBuffer {
-            position: target("gbuffer position", GBUFFER_FORMAT)?,
-            normal: target("gbuffer normal", GBUFFER_FORMAT)?,
-            geometric_normal: target("gbuffer geometric normal", GBUFFER_FORMAT)?,
-            depth: target("gbuffer depth", wgpu::TextureFormat::Depth32Float)?,
+            position: targets.position.clone(),
+            normal: targets.normal.clone(),
+            geometric_normal: targets.geometric_normal.clone(),
+            depth: targets.depth.clone(),
             view: *view,
         };
         let uniform = CameraUniform {
             view_proj: view.view_projection().to_cols_array_2d(),
             eye: view.toward_viewer().to_array(),
         };
-        let buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("camera"),
-            contents: bytemuck::bytes_of(&uniform),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
+        gpu.queue.write_buffer(&targets.camera, 0, bytemuck::bytes_of(&uniform));
         let views = [&gb.position, &gb.normal, &gb.geometric_normal].map(|t| t.create_view(&Default::default()));
         let clear =
             [wgpu::Color { r: 0.0, g: 0.0, b: 0.0, a: -1.0 }, wgpu::Color::TRANSPARENT, wgpu::Color::TRANSPARENT];
@@ -228,13 +253,9 @@ impl GBufferPass {
             Passes::One(p) => (p, None),
             Passes::Two(a, b) => (a, Some(b)),
         };
-        let mut draw = |pipeline: &wgpu::RenderPipeline, targets: &[usize], depth_load: wgpu::LoadOp<f32>| {
-            let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("gbuffer"),
-                layout: &pipeline.get_bind_group_layout(0),
-                entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }],
-            });
-            let attachments: Vec<_> = targets.iter().map(|&k| attachment(k)).collect();
+        let mut draw = |pipeline: &wgpu::RenderPipeline, outputs: &[usize], depth_load: wgpu::LoadOp<f32>| {
+            let bind = targets.bind_group(gpu, pipeline);
+            let attachments: Vec<_> = outputs.iter().map(|&k| attachment(k)).collect();
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("gbuffer"),
                 color_attachments: &attachments,
@@ -260,6 +281,65 @@ impl GBufferPass {
             }
         }
         Ok(gb)
+    }
+}
+
+/// A G-buffer's textures and camera uniform for one size, made once: what a frame renders its
+/// G-buffer into every frame ([`GBufferPass::record_into`]).
+pub struct GBufferTargets {
+    size: (u32, u32),
+    position: wgpu::Texture,
+    normal: wgpu::Texture,
+    geometric_normal: wgpu::Texture,
+    depth: wgpu::Texture,
+    camera: wgpu::Buffer,
+    // the camera's bind group for each pipeline that rendered into them
+    binds: std::sync::Mutex<Vec<(wgpu::RenderPipeline, wgpu::BindGroup)>>,
+}
+
+impl GBufferTargets {
+    /// Targets of `width` × `height` pixels.
+    ///
+    /// # Errors
+    /// [`GpuError::TooLarge`] for an image beyond the adapter's limits.
+    pub fn new(gpu: &Gpu, (w, h): (u32, u32)) -> Result<Self, GpuError> {
+        let size = (w, h, 1);
+        let target = |label, format| crate::target::render_target(gpu, label, size, format);
+        Ok(Self {
+            size: (w, h),
+            position: target("gbuffer position", GBUFFER_FORMAT)?,
+            normal: target("gbuffer normal", GBUFFER_FORMAT)?,
+            geometric_normal: target("gbuffer geometric normal", GBUFFER_FORMAT)?,
+            depth: target("gbuffer depth", wgpu::TextureFormat::Depth32Float)?,
+            camera: gpu.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("camera"),
+                size: std::mem::size_of::<CameraUniform>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            binds: std::sync::Mutex::default(),
+        })
+    }
+
+    /// Image size.
+    #[must_use]
+    pub fn size(&self) -> (u32, u32) {
+        self.size
+    }
+
+    /// The camera's bind group for `pipeline`, made the first time.
+    fn bind_group(&self, gpu: &Gpu, pipeline: &wgpu::RenderPipeline) -> wgpu::BindGroup {
+        let mut binds = self.binds.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        if let Some((_, b)) = binds.iter().find(|(p, _)| p == pipeline) {
+            return b.clone();
+        }
+        let bind = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("gbuffer"),
+            layout: &pipeline.get_bind_group_layout(0),
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: self.camera.as_entire_binding() }],
+        });
+        binds.push((pipeline.clone(), bind.clone()));
+        bind
     }
 }
 

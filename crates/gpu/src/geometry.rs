@@ -4,7 +4,6 @@
 use crate::context::{Gpu, GpuError};
 use crate::placement::{Placement, VertexWords, transform_box};
 use glam::{Affine3A, Vec3};
-use wgpu::util::DeviceExt;
 
 /// G-buffer vertex: position, shading normal, geometric normal, object index.
 #[repr(C)]
@@ -108,12 +107,12 @@ impl SceneGeometry {
             // storage bindings may not be empty
             materials.push(GpuMaterial::new(&scene::Material::lambert(0.0)));
         }
-        let vertices_buf = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        let vertices_buf = gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("scene vertices"),
             contents: bytemuck::cast_slice(&vertices),
             usage: PLACED,
         });
-        let materials_buf = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        let materials_buf = gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("materials"),
             contents: bytemuck::cast_slice(&materials),
             usage: wgpu::BufferUsages::STORAGE,
@@ -292,7 +291,7 @@ impl ShadowGeometry {
                 Chunk { first_vertex: (k * n * 3) as u32, vertex_count: (tris.len() * 3) as u32, center, radius }
             })
             .collect();
-        let vertices = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        let vertices = gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("shadow vertices"),
             contents: bytemuck::cast_slice(if flat.is_empty() { &[[0u32; 4]; 3][..] } else { &flat[..] }),
             usage: PLACED,

@@ -9,7 +9,6 @@ use crate::geometry::SceneGeometry;
 use crate::shade::{ShadeLight, ShadeParams, ShadingPass, Visibility};
 use crate::technique::{LightShape, Receivers, ShadowPassReport, ShadowTechnique, render_visibility};
 use scene::DistantLight;
-use wgpu::util::DeviceExt;
 
 /// The most light sets [`render_interleaved`] takes (each is a whole frame's shadow work).
 pub const MAX_SETS: u32 = 256;
@@ -64,13 +63,13 @@ impl InterleavePass {
             )));
         }
         let (a, b) = interleave_tile(sets);
-        let buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        let buffer = gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("interleave params"),
             contents: bytemuck::cast_slice(&[a, b, index, 0u32]),
             usage: wgpu::BufferUsages::UNIFORM,
         });
         let view = src.create_view(&Default::default());
-        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let bind = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("interleave"),
             layout: &self.pipeline.get_bind_group_layout(0),
             entries: &[

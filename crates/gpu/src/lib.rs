@@ -25,6 +25,7 @@ mod readback;
 mod receivers;
 mod shade;
 pub mod shader;
+mod slots;
 mod split;
 mod supersample;
 mod target;
@@ -38,7 +39,7 @@ pub use context::{ADAPTER_ENV, Gpu, GpuCounters, GpuError, adapters, describe_ad
 pub use from_depth::DepthGBufferPass;
 pub use gate::{Calls, Gate, GatedArgs, GpuStats, Indirect};
 pub use gbuffer::{
-    GBUFFER_FORMAT, GBuffer, GBufferPass, PointsRead, view_projection, view_projection_infinite,
+    GBUFFER_FORMAT, GBuffer, GBufferPass, GBufferTargets, PointsRead, view_projection, view_projection_infinite,
     view_projection_reverse,
 };
 pub use geometry::{Chunk, SceneGeometry, ShadowGeometry, scene_triangles};
@@ -48,6 +49,7 @@ pub use readback::{
 };
 pub use receivers::{MappedStats, PendingStats, ReceiverReduction, ReceiverStats, WeberInput};
 pub use shade::{Background, HDR_FORMAT, ShadeLight, ShadeParams, ShadingPass, Visibility, read_hdr};
+pub use slots::{Keyed, MAX_SLOTS_PER_SUBMISSION, Slots};
 pub use split::{SplitFrame, SplitImage, SplitPasses, SplitSettings, indirect_camera, record_split, render_split};
 pub use supersample::RotatedGrid;
 pub use target::{layer_view, render_target};

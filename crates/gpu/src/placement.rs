@@ -11,7 +11,6 @@
 use crate::context::{Gpu, GpuError};
 use glam::{Affine3A, Mat3, Vec3};
 use std::cell::Cell;
-use wgpu::util::DeviceExt;
 
 /// An object's transform as `place.wgsl` reads it.
 #[repr(C)]
@@ -213,7 +212,7 @@ impl Placement {
         if world.size() > limit {
             return Err(GpuError::TooLarge { what: "vertex bytes placed on the GPU", size: world.size(), limit });
         }
-        let local = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        let local = gpu.create_buffer(&wgpu::BufferDescriptor {
             label: Some("placed vertices, object space"),
             size: world.size(),
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
@@ -221,7 +220,7 @@ impl Placement {
         });
         let rows: Vec<GpuTransform> = self.transforms.iter().map(GpuTransform::new).collect();
         let rows = if rows.is_empty() { vec![GpuTransform::new(&Affine3A::IDENTITY)] } else { rows };
-        let table = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        let table = gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("object transforms"),
             contents: bytemuck::cast_slice(&rows),
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
@@ -237,12 +236,12 @@ impl Placement {
             objects: self.transforms.len() as u32,
             pad: [0; 2],
         };
-        let params = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        let params = gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("place params"),
             contents: bytemuck::bytes_of(&params),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let bind = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("place"),
             layout: &Self::pipeline(gpu).get_bind_group_layout(0),
             entries: &[

@@ -105,6 +105,8 @@ pub struct ReceiverReduction {
     weber_greedy: wgpu::ComputePipeline,
     weber_state: wgpu::Buffer,
     gate: wgpu::ComputePipeline,
+    // the gated lights' resources, kept from frame to frame
+    gate_slots: std::sync::Arc<crate::Slots<crate::gate::GateSlot>>,
     buffers: RefCell<Option<Buffers>>,
 }
 
@@ -145,19 +147,19 @@ impl ReceiverReduction {
             })
         };
         let pipeline = |entry| pipeline_of(&module, entry);
-        let weber_state = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        let weber_state = gpu.create_buffer(&wgpu::BufferDescriptor {
             label: Some("weber state"),
             size: WEBER_BYTES + 4 * 2 * Self::MAX_LIGHTS as u64,
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let stats = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        let stats = gpu.create_buffer(&wgpu::BufferDescriptor {
             label: Some("receiver stats"),
             size: ReceiverStats::BYTES,
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let histogram = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        let histogram = gpu.create_buffer(&wgpu::BufferDescriptor {
             label: Some("receiver distance histogram"),
             size: 256 * 4,
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
@@ -174,6 +176,7 @@ impl ReceiverReduction {
             weber_greedy: pipeline_of(&weber, "greedy"),
             weber_state,
             gate: pipeline_of(&gate, "gate"),
+            gate_slots: std::sync::Arc::default(),
             buffers: RefCell::new(None),
         }
     }
@@ -192,7 +195,6 @@ impl ReceiverReduction {
         lights: &[LightShape],
         weber: Option<WeberInput<'_>>,
     ) -> Result<PendingStats, GpuError> {
-        use wgpu::util::DeviceExt;
         let most = lights.len().max(weber.map_or(0, |w| w.lights.len()));
         if most > Self::MAX_LIGHTS {
             return Err(GpuError::TooLarge {
@@ -208,7 +210,7 @@ impl ReceiverReduction {
             let mut cached = self.buffers.borrow_mut();
             if cached.as_ref().is_none_or(|b| b.size != (w, h)) {
                 let storage = |label, size| {
-                    gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                    gpu.create_buffer(&wgpu::BufferDescriptor {
                         label: Some(label),
                         size,
                         usage: wgpu::BufferUsages::STORAGE,
@@ -247,14 +249,14 @@ impl ReceiverReduction {
             shapes.push(bytemuck::Zeroable::zeroed());
         }
         let buffer = |label, contents: &[u8], usage| {
-            gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+            gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
         };
         let params = [w, h, lights.len() as u32, groups.0];
         let params = buffer("receiver params", bytemuck::cast_slice(&params), wgpu::BufferUsages::UNIFORM);
         let lights_buf = buffer("receiver lights", bytemuck::cast_slice(&shapes), wgpu::BufferUsages::STORAGE);
         let position = gbuffer.position.create_view(&Default::default());
         let normal = gbuffer.geometric_normal.create_view(&Default::default());
-        let reduce = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let reduce = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("receiver reduce"),
             layout: &self.reduce.get_bind_group_layout(0),
             entries: &[
@@ -266,7 +268,7 @@ impl ReceiverReduction {
                 wgpu::BindGroupEntry { binding: 5, resource: partials.as_entire_binding() },
             ],
         });
-        let finish = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let finish = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("receiver finish"),
             layout: &self.finish.get_bind_group_layout(0),
             entries: &[
@@ -274,7 +276,7 @@ impl ReceiverReduction {
                 wgpu::BindGroupEntry { binding: 5, resource: partials.as_entire_binding() },
             ],
         });
-        let histogram_pass = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let histogram_pass = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("receiver distance histogram"),
             layout: &self.histogram_pass.get_bind_group_layout(0),
             entries: &[
@@ -284,7 +286,7 @@ impl ReceiverReduction {
                 wgpu::BindGroupEntry { binding: 6, resource: self.histogram.as_entire_binding() },
             ],
         });
-        let select_digit = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let select_digit = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("receiver distance select"),
             layout: &self.select_digit.get_bind_group_layout(0),
             entries: &[
@@ -312,7 +314,7 @@ impl ReceiverReduction {
                 pass.dispatch_workgroups(1, 1, 1);
             }
         }
-        let read = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        let read = gpu.create_buffer(&wgpu::BufferDescriptor {
             label: Some("receiver stats read"),
             size: ReceiverStats::BYTES,
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
@@ -330,6 +332,7 @@ impl ReceiverReduction {
             weber: weber.as_ref().map(|_| self.weber_state.clone()),
             gate: self.gate.clone(),
             first: 0,
+            slots: self.gate_slots.clone(),
         };
         Ok(PendingStats { read, lights: lights.len(), weber, on_gpu })
     }
@@ -344,7 +347,6 @@ impl ReceiverReduction {
         (stride, columns, rows): (u32, u32, u32),
         (totals, skipped): (&wgpu::Buffer, &wgpu::Buffer),
     ) -> Result<wgpu::Buffer, GpuError> {
-        use wgpu::util::DeviceExt;
         // as `weber_negligible` computes them, so that the shader starts from the same bits
         let luminance = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
         let mut lights: Vec<GpuLight> = input
@@ -369,14 +371,14 @@ impl ReceiverReduction {
             sh: input.ambient.map_or([[0.0; 4]; 9], |a| a.irradiance_coefficients().map(|c| c.extend(0.0).to_array())),
         };
         let buffer = |label, contents: &[u8], usage| {
-            gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+            gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
         };
         let params = buffer("weber params", bytemuck::bytes_of(&params), wgpu::BufferUsages::UNIFORM);
         let lights = buffer("weber lights", bytemuck::cast_slice(&lights), wgpu::BufferUsages::STORAGE);
         let position = gbuffer.position.create_view(&Default::default());
         let normal = gbuffer.geometric_normal.create_view(&Default::default());
         let bind = |pipeline: &wgpu::ComputePipeline| {
-            gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            gpu.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("weber"),
                 layout: &pipeline.get_bind_group_layout(0),
                 entries: &[
@@ -402,7 +404,7 @@ impl ReceiverReduction {
             pass.set_bind_group(0, &greedy_bind, &[]);
             pass.dispatch_workgroups(1, 1, 1);
         }
-        let read = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        let read = gpu.create_buffer(&wgpu::BufferDescriptor {
             label: Some("weber read"),
             size: WEBER_BYTES,
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,

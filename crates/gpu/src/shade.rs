@@ -278,12 +278,12 @@ impl ShadingPass {
         if lights.is_empty() {
             lights.push(bytemuck::Zeroable::zeroed());
         }
-        let uniform_buf = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        let uniform_buf = gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("shade params"),
             contents: bytemuck::bytes_of(&uniform),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let light_buf = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        let light_buf = gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("lights"),
             contents: bytemuck::cast_slice(&lights),
             usage: wgpu::BufferUsages::STORAGE,
@@ -297,7 +297,7 @@ impl ShadingPass {
         let levels_view = specular.levels.create_view(&array);
         let background_view = background.create_view(&array);
         let table_view = specular.table.create_view(&Default::default());
-        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let bind = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("shade"),
             layout: &self.pipeline.get_bind_group_layout(0),
             entries: &[

@@ -15,7 +15,7 @@ pub fn render_target(
     format: wgpu::TextureFormat,
 ) -> Result<wgpu::Texture, GpuError> {
     gpu.check_texture(width, height, layers)?;
-    Ok(gpu.device.create_texture(&wgpu::TextureDescriptor {
+    Ok(gpu.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
         size: wgpu::Extent3d { width, height, depth_or_array_layers: layers },
         mip_level_count: 1,

@@ -366,12 +366,7 @@ pub fn render_visibility(
     });
     let bytes = 8 * u64::from(queries);
     let buffer = |label, usage| {
-        gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some(label),
-            size: bytes,
-            usage,
-            mapped_at_creation: false,
-        })
+        gpu.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size: bytes, usage, mapped_at_creation: false })
     };
     let resolve = buffer("per-light timestamps", wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC);
     let read = buffer("per-light timestamps read", wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
@@ -575,7 +570,6 @@ impl ShadowTechnique for PrecomputedVisibility {
         gate: Option<Gate<'_>>,
         target: &wgpu::TextureView,
     ) -> Result<ShadowPassReport, GpuError> {
-        use wgpu::util::DeviceExt;
         let Some((_, values)) = self.layers.iter().find(|(l, _)| l == light) else {
             return Err(GpuError::Failed(format!("{}: no visibility for {light:?}", self.name)));
         };
@@ -589,11 +583,11 @@ impl ShadowTechnique for PrecomputedVisibility {
         }
         let params = [self.size.0, self.size.1, 0, 0];
         let buffer = |label, contents: &[u8], usage| {
-            gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+            gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
         };
         let params = buffer("upload params", bytemuck::cast_slice(&params), wgpu::BufferUsages::UNIFORM);
         let values = buffer("upload values", bytemuck::cast_slice(values), wgpu::BufferUsages::STORAGE);
-        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let bind = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("upload"),
             layout: &self.pipeline.get_bind_group_layout(0),
             entries: &[

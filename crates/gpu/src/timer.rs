@@ -42,13 +42,13 @@ impl Gpu {
             ty: wgpu::QueryType::Timestamp,
             count: 2,
         });
-        let resolve = self.device.create_buffer(&wgpu::BufferDescriptor {
+        let resolve = self.create_buffer(&wgpu::BufferDescriptor {
             label: Some("timestamps"),
             size: 16,
             usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let read = self.device.create_buffer(&wgpu::BufferDescriptor {
+        let read = self.create_buffer(&wgpu::BufferDescriptor {
             label: Some("timestamps readback"),
             size: 16,
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,

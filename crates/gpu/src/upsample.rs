@@ -6,7 +6,6 @@
 use crate::context::{Gpu, GpuError};
 use crate::gbuffer::GBuffer;
 use crate::geometry::SceneGeometry;
-use wgpu::util::DeviceExt;
 
 /// The Gaussians of joint bilateral upsampling. A sigma of infinity turns its term off (all
 /// range sigmas infinite: plain Gaussian upsampling).
@@ -143,7 +142,7 @@ impl UpsamplePass {
             .map(|v| if v == f32::MAX { 0.0 } else { v }),
             info: [factor, s.radius, lw, lh],
         };
-        let buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        let buffer = gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("upsample params"),
             contents: bytemuck::bytes_of(&uniform),
             usage: wgpu::BufferUsages::UNIFORM,
@@ -158,7 +157,7 @@ impl UpsamplePass {
             entries
                 .push(wgpu::BindGroupEntry { binding: 2 + k as u32, resource: wgpu::BindingResource::TextureView(v) });
         }
-        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let bind = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("upsample"),
             layout: &self.pipeline.get_bind_group_layout(0),
             entries: &entries,

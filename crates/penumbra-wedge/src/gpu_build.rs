@@ -15,7 +15,6 @@
 use crate::casters::Casters;
 use gpu::{Gpu, GpuError};
 use std::collections::BTreeMap;
-use wgpu::util::DeviceExt;
 
 /// Edges a workgroup of `mark` and `emit` handles (build.wgsl's workgroup size).
 pub(crate) const BLOCK: u32 = 256;
@@ -80,7 +79,7 @@ pub(crate) struct GpuBuilder {
 }
 
 fn storage(gpu: &Gpu, label: &str, bytes: u64, extra: wgpu::BufferUsages) -> wgpu::Buffer {
-    gpu.device.create_buffer(&wgpu::BufferDescriptor {
+    gpu.create_buffer(&wgpu::BufferDescriptor {
         label: Some(label),
         size: bytes.max(16),
         usage: wgpu::BufferUsages::STORAGE | extra,
@@ -217,7 +216,7 @@ impl MeshBuffers {
         }
         let init = |label, contents: &[u8], usage| {
             let contents = if contents.is_empty() { &[0u8; 16][..] } else { contents };
-            gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+            gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
         };
         let read = wgpu::BufferUsages::STORAGE;
         let blocks = (edges.len() as u64).div_ceil(u64::from(BLOCK));
@@ -300,7 +299,7 @@ impl GpuBuilder {
             emit: pipeline("emit"),
             footprint: pipeline("footprint"),
             mesh: MeshBuffers::new(gpu, casters, edges_per_footprint),
-            counts: gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            counts: gpu.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("wedge counts"),
                 size: 4 * ARG_WORDS * u64::from(COUNT_SLOTS),
                 usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
@@ -375,7 +374,7 @@ impl GpuBuilder {
                 .filter(|(b, _)| used.contains(b))
                 .map(|(b, buf)| wgpu::BindGroupEntry { binding: *b, resource: buf.as_entire_binding() })
                 .collect();
-            gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            gpu.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("wedge build"),
                 layout: &pipeline.get_bind_group_layout(0),
                 entries: &entries,

@@ -35,7 +35,6 @@ use gpu::accumulate::{Accumulator, ResolvePass};
 use gpu::{Calls, Gpu, GpuError, Indirect, LightShape, Receivers, ShadowPassReport, ShadowTechnique};
 use gpu_build::{GpuBuilder, LightBuild};
 use std::cell::RefCell;
-use wgpu::util::DeviceExt;
 
 /// How wedges reach the pixels they cover.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -185,6 +184,18 @@ pub struct Wedges {
     polygons: wgpu::RenderPipeline,
     // screen-sized targets reused from light to light (passes recorded in order), per size
     scratch: RefCell<Option<Scratch>>,
+    // the GPU-built lights' uniforms and bind groups, kept from frame to frame
+    slots: gpu::Slots<LightSlot>,
+}
+
+/// One GPU-built light's resources ([`gpu::Slots`]): its build uniform (whose first words are
+/// the wedge pass's light), per-caster parameters and view, and the bind groups of its seven
+/// passes over them, the builder's buffers and the G-buffer.
+struct LightSlot {
+    uniform: wgpu::Buffer,
+    casters: wgpu::Buffer,
+    view: wgpu::Buffer,
+    binds: gpu::Keyed<(wgpu::Buffer, wgpu::Texture, wgpu::Texture), [wgpu::BindGroup; 7]>,
 }
 
 /// A light's screen-sized scratch targets.
@@ -245,7 +256,7 @@ fn view_uniform(view: &gpu::View, view_proj: &Mat4, bounds: Option<(Vec3, Vec3)>
 
 /// The compute path's R32Float sum of edge terms (zero-initialized).
 fn edge_sum_texture(gpu: &Gpu, (w, h): (u32, u32)) -> wgpu::Texture {
-    gpu.device.create_texture(&wgpu::TextureDescriptor {
+    gpu.create_texture(&wgpu::TextureDescriptor {
         label: Some("wedge edge sum"),
         size: wgpu::Extent3d { width: w.max(1), height: h.max(1), depth_or_array_layers: 1 },
         mip_level_count: 1,
@@ -376,12 +387,13 @@ impl Wedges {
             builder,
             polygons,
             scratch: RefCell::new(None),
+            slots: gpu::Slots::new(),
         }
     }
 
     /// The volume pass's bind group: the view, the G-buffer's positions.
     fn volume_bind(&self, gpu: &Gpu, view: &wgpu::Buffer, position: &wgpu::TextureView) -> wgpu::BindGroup {
-        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        gpu.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("shadow volume"),
             layout: &self.volume.get_bind_group_layout(0),
             entries: &[
@@ -658,39 +670,65 @@ impl Wedges {
             ],
             counts,
         };
-        let device = &gpu.device;
-        let buffer = |label, contents: &[u8], usage| {
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
-        };
         let mut caster_words = params;
-        if caster_words.is_empty() {
-            caster_words.push([0.0; 4]);
-        }
-        let uniform_buf = buffer("wedge build", bytemuck::bytes_of(&uniform), wgpu::BufferUsages::UNIFORM);
-        let casters_buf = buffer("wedge casters", bytemuck::cast_slice(&caster_words), wgpu::BufferUsages::STORAGE);
+        // one row a caster whatever the light (culled rows stay zero), at least one
+        caster_words.resize(self.casters.casters.len().max(1), [0.0; 4]);
         let view = view_uniform(&gb.view, &view_proj, receivers.bounds, extent);
-        let view_buf = buffer("wedge view", bytemuck::bytes_of(&view), wgpu::BufferUsages::UNIFORM);
-        // the wedge pass's light: the build uniform's first words (`Build.light`)
-        let light_binding = wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-            buffer: &uniform_buf,
-            offset: 0,
-            size: wgpu::BufferSize::new(std::mem::size_of_val(&light_params) as u64),
-        });
-        let binds = self.builder.bind_groups(gpu, mesh, &LightBuild { uniform: &uniform_buf, casters: &casters_buf });
-        let position = gb.position.create_view(&Default::default());
-        let normal = gb.geometric_normal.create_view(&Default::default());
-        let volume_bind = self.volume_bind(gpu, &view_buf, &position);
-        let wedge_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("wedges"),
-            layout: &self.polygons.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: light_binding },
-                wgpu::BindGroupEntry { binding: 1, resource: mesh.silhouette.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&position) },
-                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&normal) },
-                wgpu::BindGroupEntry { binding: 4, resource: mesh.footprints.as_entire_binding() },
-            ],
-        });
+        let caster_bytes = std::mem::size_of_val(caster_words.as_slice()) as u64;
+        let make = || {
+            let buffer = |label, size, usage: wgpu::BufferUsages| {
+                gpu.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size,
+                    usage: usage | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                })
+            };
+            Ok(LightSlot {
+                uniform: buffer("wedge build", std::mem::size_of::<BuildUniform>() as u64, wgpu::BufferUsages::UNIFORM),
+                casters: buffer("wedge casters", caster_bytes, wgpu::BufferUsages::STORAGE),
+                view: buffer("wedge view", std::mem::size_of::<ViewUniform>() as u64, wgpu::BufferUsages::UNIFORM),
+                binds: gpu::Keyed::default(),
+            })
+        };
+        let binds = self.slots.next(gpu, make, |slot| {
+            if slot.casters.size() < caster_bytes {
+                *slot = make()?;
+            }
+            gpu.queue.write_buffer(&slot.uniform, 0, bytemuck::bytes_of(&uniform));
+            gpu.queue.write_buffer(&slot.casters, 0, bytemuck::cast_slice(&caster_words));
+            gpu.queue.write_buffer(&slot.view, 0, bytemuck::bytes_of(&view));
+            let key = (mesh.silhouette.clone(), gb.position.clone(), gb.geometric_normal.clone());
+            let (uniform_buf, casters_buf, view_buf) = (slot.uniform.clone(), slot.casters.clone(), slot.view.clone());
+            let binds = slot.binds.get(key, || {
+                // the wedge pass's light: the build uniform's first words (`Build.light`)
+                let light_binding = wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &uniform_buf,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(std::mem::size_of_val(&light_params) as u64),
+                });
+                let build = LightBuild { uniform: &uniform_buf, casters: &casters_buf };
+                let [classify, mark, scan, emit, footprint] = self.builder.bind_groups(gpu, mesh, &build);
+                let position = gb.position.create_view(&Default::default());
+                let normal = gb.geometric_normal.create_view(&Default::default());
+                let volume = self.volume_bind(gpu, &view_buf, &position);
+                let wedge = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("wedges"),
+                    layout: &self.polygons.get_bind_group_layout(0),
+                    entries: &[
+                        wgpu::BindGroupEntry { binding: 0, resource: light_binding },
+                        wgpu::BindGroupEntry { binding: 1, resource: mesh.silhouette.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&position) },
+                        wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&normal) },
+                        wgpu::BindGroupEntry { binding: 4, resource: mesh.footprints.as_entire_binding() },
+                    ],
+                });
+                Ok([classify, mark, scan, emit, footprint, volume, wedge])
+            })?;
+            Ok(binds.clone())
+        })?;
+        let [classify, mark, scan, emit, footprint, volume_bind, wedge_bind] = binds;
+        let binds = [classify, mark, scan, emit, footprint];
         let scratch = self.scratch(gpu, gb.size())?;
         let acc = &scratch.accumulator;
         // moved casters' vertices first (nothing when none moved)
@@ -742,8 +780,7 @@ impl Wedges {
             pass.draw_indirect(&mesh.args, 16);
         }
         self.builder.keep_counts(encoder, mesh);
-        let sum = self.no_edge_sum.create_view(&Default::default());
-        let extra = [(3, wgpu::BindingResource::TextureView(&normal)), (4, wgpu::BindingResource::TextureView(&sum))];
+        let extra = [(3, &gb.geometric_normal), (4, &self.no_edge_sum)];
         self.resolve.record(
             gpu,
             encoder,
@@ -753,7 +790,7 @@ impl Wedges {
             &extra,
             Some((&calls, 4)),
             target,
-        );
+        )?;
         Ok(ShadowPassReport {
             time: std::time::Duration::ZERO,
             clock: None,
@@ -817,7 +854,6 @@ impl ShadowTechnique for Wedges {
         let extent = self.extent(receivers.bounds);
         let view_proj = gb.view.unclipped_projection(extent * 1e-6);
         let plan = self.plan(light, receivers.bounds, &view_proj);
-        let device = &gpu.device;
         let volume: Vec<[f32; 3]> = plan.volume.iter().flatten().map(|v| v.to_array()).collect();
         let footprints: Vec<FootprintVertex> = plan
             .footprints
@@ -837,7 +873,7 @@ impl ShadowTechnique for Wedges {
             edges.push([[0.0; 4]; 4]);
         }
         let buffer = |label, contents: &[u8], usage| {
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+            gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
         };
         let light_params = light_uniform(light, self.settings.cosine_weighted);
         let view = view_uniform(&gb.view, &view_proj, receivers.bounds, extent);
@@ -853,7 +889,7 @@ impl ShadowTechnique for Wedges {
         let position = gb.position.create_view(&Default::default());
         let normal = gb.geometric_normal.create_view(&Default::default());
         let volume_bind = self.volume_bind(gpu, &view_buf, &position);
-        let wedge_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let wedge_bind = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("wedges"),
             layout: &self.wedge.get_bind_group_layout(0),
             entries: &[
@@ -879,7 +915,7 @@ impl ShadowTechnique for Wedges {
             let ranges_buf =
                 buffer("wedge tile ranges", bytemuck::cast_slice(&bins.ranges), wgpu::BufferUsages::STORAGE);
             let groups_buf = buffer("wedge tile groups", bytemuck::cast_slice(&groups), wgpu::BufferUsages::STORAGE);
-            let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            let bind = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("wedge tiles"),
                 layout: &self.tiles.get_bind_group_layout(0),
                 entries: &[
@@ -937,11 +973,10 @@ impl ShadowTechnique for Wedges {
                 pass.set_bind_group(0, bind, &[]);
                 calls.dispatch(&mut pass, 2);
             }
-            let sum = compute.as_ref().map_or(&self.no_edge_sum, |(t, _, _)| t).create_view(&Default::default());
-            let extra =
-                [(3, wgpu::BindingResource::TextureView(&normal)), (4, wgpu::BindingResource::TextureView(&sum))];
+            let sum = compute.as_ref().map_or(&self.no_edge_sum, |(t, _, _)| t);
+            let extra = [(3, &gb.geometric_normal), (4, sum)];
             let params = bytemuck::cast_slice(&light_params);
-            self.resolve.record(gpu, encoder, gb, acc, params, &extra, Some((&calls, 3)), target);
+            self.resolve.record(gpu, encoder, gb, acc, params, &extra, Some((&calls, 3)), target)?;
         }
         Ok(ShadowPassReport {
             time: std::time::Duration::ZERO,

@@ -403,6 +403,9 @@ pub fn run(map: Option<&Path>, out: &Path, frames: usize, (w, h): (u32, u32)) ->
         let weber = WeberInput { lights: &shade, ambient: Some(&decomposition.ambient_sh), fraction: WEBER_FRACTION };
         let pending = reduction.record(&gpu, &mut encoder, &gbuffer, &shapes, Some(weber))?;
         queue.submit([encoder.finish()]);
+        // submitted by the renderer, not through `Gpu::submit`: the techniques may now reuse
+        // their per-light uniforms for the next frame's lights (gpu::Slots)
+        gpu.mark_submitted();
 
         // every light's visibility recorded into the renderer's encoder, then its shading: the
         // reduction stays on the GPU, gates each light's draws and fits the orthographic maps
@@ -424,6 +427,7 @@ pub fn run(map: Option<&Path>, out: &Path, frames: usize, (w, h): (u32, u32)) ->
             wgpu::LoadOp::Clear(wgpu::Color::BLACK),
         );
         queue.submit([encoder.finish()]);
+        gpu.mark_submitted();
 
         // the example's own output: the frame as an 8-bit PNG
         let pixels = gpu::read_texture_rgba(&gpu, &hdr, 0)?;

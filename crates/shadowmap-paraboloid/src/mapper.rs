@@ -6,7 +6,6 @@ use crate::{Rejection, ShadowLight, ShadowSettings, Technique};
 use glam::{Mat4, Vec3};
 use gpu::{Calls, Chunk, Clock, GBuffer, Gate, Gpu, GpuError, GpuStats, Indirect, ShadowGeometry};
 use std::time::Duration;
-use wgpu::util::DeviceExt;
 
 /// This crate's WGSL library files (for `// requires:` lines; shaders that read its maps use
 /// `lookup.wgsl`).
@@ -184,6 +183,34 @@ pub struct ShadowMapper {
     visibility_add: wgpu::RenderPipeline,
     // an orthographic view fitted on the GPU (`ortho_focus.wgsl`)
     focus: wgpu::ComputePipeline,
+    // each map of a submission's uniforms and bind groups, kept from frame to frame: its
+    // views, its fitted focus, its visibility pass (one cursor a stage, the stages run in the
+    // same order for every map)
+    view_slots: gpu::Slots<ViewSlot>,
+    focus_slots: gpu::Slots<FocusSlot>,
+    visibility_slots: gpu::Slots<VisibilitySlot>,
+}
+
+/// A map's view uniforms and their bind groups (grown to the most views a map has had).
+#[derive(Default)]
+struct ViewSlot {
+    buffers: Vec<wgpu::Buffer>,
+    binds: Vec<wgpu::BindGroup>,
+}
+
+/// A map's orthographic focus: its parameters, the view it writes, and the bind group over
+/// them and the receivers' statistics.
+struct FocusSlot {
+    params: wgpu::Buffer,
+    view: wgpu::Buffer,
+    bind: gpu::Keyed<wgpu::Buffer, wgpu::BindGroup>,
+}
+
+/// A map's visibility pass: its parameters and the bind group over them, the G-buffer and the
+/// map's layers.
+struct VisibilitySlot {
+    params: wgpu::Buffer,
+    bind: gpu::Keyed<(wgpu::RenderPipeline, wgpu::Texture, wgpu::Texture, wgpu::Texture, u32, u32), wgpu::BindGroup>,
 }
 
 /// Where a visibility pass writes.
@@ -417,6 +444,9 @@ impl ShadowMapper {
             view_layout,
             visibility,
             visibility_add,
+            view_slots: gpu::Slots::new(),
+            focus_slots: gpu::Slots::new(),
+            visibility_slots: gpu::Slots::new(),
         }
     }
 
@@ -531,25 +561,36 @@ impl ShadowMapper {
             info: [resolution as f32, 0.0, 0.0, 0.0],
             words: [GpuStats::COUNT_WORD, GpuStats::MEAN_WORD, GpuStats::RADIUS_WORD, 0],
         };
-        let params = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("orthographic focus"),
-            contents: bytemuck::bytes_of(&params),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let view = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("orthographic view"),
-            size: std::mem::size_of::<ViewUniform>() as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("orthographic focus"),
-            layout: &self.focus.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: stats.buffer().as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: view.as_entire_binding() },
-            ],
+        let make = || FocusSlot {
+            params: gpu.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("orthographic focus"),
+                size: std::mem::size_of::<FocusParams>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            view: gpu.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("orthographic view"),
+                size: std::mem::size_of::<ViewUniform>() as u64,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            }),
+            bind: gpu::Keyed::default(),
+        };
+        let (view, bind) = self.focus_slots.next_or_own(gpu, make, |slot| {
+            gpu.queue.write_buffer(&slot.params, 0, bytemuck::bytes_of(&params));
+            let (buffer, view) = (slot.params.clone(), slot.view.clone());
+            let bind = slot.bind.get_or_make(stats.buffer().clone(), || {
+                gpu.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("orthographic focus"),
+                    layout: &self.focus.get_bind_group_layout(0),
+                    entries: &[
+                        wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 1, resource: stats.buffer().as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 2, resource: view.as_entire_binding() },
+                    ],
+                })
+            });
+            (view, bind.clone())
         });
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("orthographic focus"),
@@ -701,26 +742,27 @@ impl ShadowMapper {
         };
         let layer_views: Vec<wgpu::TextureView> =
             (0..layers).map(|l| gpu::layer_view(&texture, first_layer + l)).collect();
-        let view_buffers: Vec<wgpu::Buffer> = views
-            .iter()
-            .map(|(v, _)| {
-                gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        let uniforms: Vec<ViewUniform> = views.iter().map(|(v, _)| v.uniform()).collect();
+        let (view_buffers, binds) = self.view_slots.next_or_own(gpu, ViewSlot::default, |slot| {
+            while slot.buffers.len() < uniforms.len() {
+                let buffer = gpu.create_buffer(&wgpu::BufferDescriptor {
                     label: Some("shadow view"),
-                    contents: bytemuck::bytes_of(&v.uniform()),
+                    size: std::mem::size_of::<ViewUniform>() as u64,
                     usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                })
-            })
-            .collect();
-        let binds: Vec<wgpu::BindGroup> = view_buffers
-            .iter()
-            .map(|buffer| {
-                gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    mapped_at_creation: false,
+                });
+                slot.binds.push(gpu.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("shadow view"),
                     layout: &self.view_layout,
                     entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }],
-                })
-            })
-            .collect();
+                }));
+                slot.buffers.push(buffer);
+            }
+            for (buffer, u) in slot.buffers.iter().zip(&uniforms) {
+                gpu.queue.write_buffer(buffer, 0, bytemuck::bytes_of(u));
+            }
+            (slot.buffers[..uniforms.len()].to_vec(), slot.binds[..uniforms.len()].to_vec())
+        });
         // each chunk classified once per view, before recording
         let classes: Vec<Vec<Class>> =
             views.iter().map(|(_, classify)| geometry.chunks.iter().map(classify).collect()).collect();
@@ -814,37 +856,61 @@ impl ShadowMapper {
     ) {
         // the view below starts at the map's first layer
         let params = map.lookup_params(half_angle, 0);
-        let buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("visibility params"),
-            contents: bytemuck::bytes_of(&params),
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        });
-        if let Some(view) = &map.gpu_view {
-            let size = std::mem::size_of::<ViewUniform>() as u64;
-            encoder.copy_buffer_to_buffer(view, 0, &buffer, FIRST_VIEW_OFFSET, size);
-        }
-        let position = gbuffer.position.create_view(&Default::default());
-        let normal = gbuffer.geometric_normal.create_view(&Default::default());
-        let shadow = map.texture.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            aspect: wgpu::TextureAspect::DepthOnly,
-            base_array_layer: map.first_layer,
-            array_layer_count: Some(map.views.len() as u32),
-            ..Default::default()
-        });
         let pipeline = match target {
             VisibilityTarget::Layer(_) => &self.visibility,
             VisibilityTarget::Add(..) => &self.visibility_add,
         };
-        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("visibility"),
-            layout: &pipeline.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&position) },
-                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&normal) },
-                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&shadow) },
-            ],
+        let make = || VisibilitySlot {
+            params: gpu.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("visibility params"),
+                size: std::mem::size_of_val(&params) as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            bind: gpu::Keyed::default(),
+        };
+        let layers = map.views.len() as u32;
+        let bind = self.visibility_slots.next_or_own(gpu, make, |slot| {
+            gpu.queue.write_buffer(&slot.params, 0, bytemuck::bytes_of(&params));
+            if let Some(view) = &map.gpu_view {
+                let size = std::mem::size_of::<ViewUniform>() as u64;
+                encoder.copy_buffer_to_buffer(view, 0, &slot.params, FIRST_VIEW_OFFSET, size);
+            }
+            let key = (
+                pipeline.clone(),
+                gbuffer.position.clone(),
+                gbuffer.geometric_normal.clone(),
+                map.texture.clone(),
+                map.first_layer,
+                layers,
+            );
+            let buffer = slot.params.clone();
+            slot.bind
+                .get_or_make(key, || {
+                    let position = gbuffer.position.create_view(&Default::default());
+                    let normal = gbuffer.geometric_normal.create_view(&Default::default());
+                    let shadow = map.texture.create_view(&wgpu::TextureViewDescriptor {
+                        dimension: Some(wgpu::TextureViewDimension::D2Array),
+                        aspect: wgpu::TextureAspect::DepthOnly,
+                        base_array_layer: map.first_layer,
+                        array_layer_count: Some(layers),
+                        ..Default::default()
+                    });
+                    gpu.create_bind_group(&wgpu::BindGroupDescriptor {
+                        label: Some("visibility"),
+                        layout: &pipeline.get_bind_group_layout(0),
+                        entries: &[
+                            wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() },
+                            wgpu::BindGroupEntry {
+                                binding: 1,
+                                resource: wgpu::BindingResource::TextureView(&position),
+                            },
+                            wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&normal) },
+                            wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&shadow) },
+                        ],
+                    })
+                })
+                .clone()
         });
         let attachment = match target {
             VisibilityTarget::Layer(view) => wgpu::RenderPassColorAttachment {

@@ -261,7 +261,7 @@ impl ShadowTechnique for MapTechnique {
             let scale = [1.0 / lights.len() as f32, 0.0, 0.0, 0.0];
             let params = bytemuck::cast_slice(&scale);
             let call = Some((&calls, resolve_call));
-            shared.resolve.record(gpu, encoder, receivers.gbuffer, a, params, &[], call, target);
+            shared.resolve.record(gpu, encoder, receivers.gbuffer, a, params, &[], call, target)?;
         }
         Ok(ShadowPassReport { time: Duration::ZERO, clock: None, skipped: None, primitives, culled: Vec::new() })
     }

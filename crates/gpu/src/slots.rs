@@ -1,0 +1,154 @@
+//! Per-light resources made once and reused from frame to frame. A technique that records
+//! several lights into one submission needs each light's uniforms in buffers of their own
+//! (`queue.write_buffer` lands before the whole submission runs, so one buffer rewritten from
+//! light to light would hold the last light's values for all of them). [`Slots`] hands out one
+//! slot a light in the order lights are recorded and starts over at the next submission
+//! ([`crate::Gpu::epoch`]): the k-th light of every frame gets the same slot, its buffers and
+//! bind groups, updated with `queue.write_buffer`. A frame makes new slots only when it records
+//! more lights than any frame before it.
+
+use crate::context::{Gpu, GpuError};
+use std::sync::Mutex;
+
+/// The most slots one [`Slots`] hands out between two submissions: more means the caller
+/// submits through its own queue without [`Gpu::mark_submitted`], and the slots would grow
+/// for ever.
+pub const MAX_SLOTS_PER_SUBMISSION: usize = 4096;
+
+/// Resources of type `T`, one a light recorded in a submission; see the module's documentation.
+pub struct Slots<T> {
+    inner: Mutex<Inner<T>>,
+}
+
+struct Inner<T> {
+    slots: Vec<T>,
+    // the next slot to hand out, and the submission epoch it counts within
+    next: usize,
+    epoch: u64,
+}
+
+impl<T> Default for Slots<T> {
+    fn default() -> Self {
+        Self { inner: Mutex::new(Inner { slots: Vec::new(), next: 0, epoch: u64::MAX }) }
+    }
+}
+
+impl<T> std::fmt::Debug for Slots<T> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Slots({} made)", self.made())
+    }
+}
+
+impl<T> Slots<T> {
+    /// No slot yet.
+    #[must_use]
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Calls `f` on the next slot of this submission, made by `make` when no frame has used it
+    /// before.
+    ///
+    /// # Errors
+    /// [`GpuError::TooLarge`] past [`MAX_SLOTS_PER_SUBMISSION`] slots in one submission;
+    /// `make`'s and `f`'s errors.
+    pub fn next<R>(
+        &self,
+        gpu: &Gpu,
+        make: impl FnOnce() -> Result<T, GpuError>,
+        f: impl FnOnce(&mut T) -> Result<R, GpuError>,
+    ) -> Result<R, GpuError> {
+        let mut inner = self.inner.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        let epoch = gpu.epoch();
+        if inner.epoch != epoch {
+            inner.epoch = epoch;
+            inner.next = 0;
+        }
+        let k = inner.next;
+        if k >= MAX_SLOTS_PER_SUBMISSION {
+            return Err(GpuError::TooLarge {
+                what: "lights recorded in one submission (submit through Gpu::submit or call Gpu::mark_submitted)",
+                size: k as u64 + 1,
+                limit: MAX_SLOTS_PER_SUBMISSION as u64,
+            });
+        }
+        if k == inner.slots.len() {
+            let slot = make()?;
+            inner.slots.push(slot);
+        }
+        inner.next += 1;
+        f(&mut inner.slots[k])
+    }
+
+    /// As [`Slots::next`] with `make` and `f` that cannot fail: past
+    /// [`MAX_SLOTS_PER_SUBMISSION`] slots, `f` gets a slot of the light's own, made for it and
+    /// dropped after (correct, only not reused).
+    pub fn next_or_own<R>(&self, gpu: &Gpu, make: impl Fn() -> T, f: impl FnOnce(&mut T) -> R) -> R {
+        let mut f = Some(f);
+        match self.next(gpu, || Ok(make()), |slot| Ok(f.take().map(|f| f(slot)))) {
+            Ok(Some(r)) => r,
+            _ => (f.take().expect("not called when the slots refused"))(&mut make()),
+        }
+    }
+
+    /// Slots made so far.
+    #[must_use]
+    pub fn made(&self) -> usize {
+        self.inner.lock().map_or(0, |i| i.slots.len())
+    }
+}
+
+/// A value kept with the resources it was made from, made again when they change: a bind
+/// group with the textures and buffers it binds.
+#[derive(Debug)]
+pub struct Keyed<K, V> {
+    entry: Option<(K, V)>,
+}
+
+impl<K, V> Default for Keyed<K, V> {
+    fn default() -> Self {
+        Self { entry: None }
+    }
+}
+
+impl<K: PartialEq, V> Keyed<K, V> {
+    /// The value for `key`, made by `make` when the key differs from the last one.
+    ///
+    /// # Errors
+    /// `make`'s.
+    pub fn get(&mut self, key: K, make: impl FnOnce() -> Result<V, GpuError>) -> Result<&V, GpuError> {
+        if self.entry.as_ref().is_none_or(|(k, _)| *k != key) {
+            self.entry = Some((key, make()?));
+        }
+        Ok(&self.entry.as_ref().expect("just set").1)
+    }
+
+    /// As [`Keyed::get`] with a `make` that cannot fail.
+    pub fn get_or_make(&mut self, key: K, make: impl FnOnce() -> V) -> &V {
+        if self.entry.as_ref().is_none_or(|(k, _)| *k != key) {
+            self.entry = Some((key, make()));
+        }
+        &self.entry.as_ref().expect("just set").1
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn keyed_values_are_made_again_only_when_their_key_changes() {
+        let mut k: Keyed<u32, u32> = Keyed::default();
+        let mut made = 0;
+        for key in [1, 1, 2, 2, 1] {
+            let v = *k
+                .get(key, || {
+                    made += 1;
+                    Ok(key * 10)
+                })
+                .unwrap();
+            assert_eq!(v, key * 10);
+        }
+        assert_eq!(made, 3);
+    }
+}
