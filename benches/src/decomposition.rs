@@ -108,7 +108,7 @@ pub struct Frame {
     // what the frame renders into, made once: the full-resolution G-buffer, the low one (for
     // the last scale asked) and the EnvDirects' visibility
     targets: GBufferTargets,
-    low_targets: RefCell<Option<(u32, Rc<GBufferTargets>)>>,
+    low_targets: RefCell<gpu::Keyed<u32, Rc<GBufferTargets>>>,
     direct_visibility: Visibility,
 }
 
@@ -136,7 +136,7 @@ impl Frame {
         let size = (scene.camera.width, scene.camera.height);
         Ok(Self {
             targets: GBufferTargets::new(gpu, size).map_err(e)?,
-            low_targets: RefCell::new(None),
+            low_targets: RefCell::default(),
             direct_visibility: Visibility::allocate(gpu, size.0, size.1, decomposition.directs() as u32).map_err(e)?,
             geometry: SceneGeometry::upload(gpu, &scene).map_err(e)?,
             gbuffer: GBufferPass::new(gpu),
@@ -269,7 +269,9 @@ impl Frame {
         let low_gb = if scale == 1 {
             None
         } else {
-            let low = self.low_targets(gpu, scale, (low_camera.width, low_camera.height))?;
+            let size = (low_camera.width, low_camera.height);
+            let low =
+                self.low_targets.borrow_mut().try_get(scale, || GBufferTargets::new(gpu, size).map(Rc::new))?.clone();
             let view = GBufferPass::camera_view(&self.geometry, low_camera);
             Some(self.gbuffer.record_into(gpu, &mut encoder, &self.geometry, &view, &low)?)
         };
@@ -279,17 +281,6 @@ impl Frame {
         }
         gpu.submit(encoder);
         Ok((gb, low_gb, pending))
-    }
-
-    /// The low-resolution G-buffer's targets for `scale`, made when the scale changes.
-    fn low_targets(&self, gpu: &Gpu, scale: u32, size: (u32, u32)) -> Result<Rc<GBufferTargets>, GpuError> {
-        let mut low = self.low_targets.borrow_mut();
-        if let Some((_, t)) = low.as_ref().filter(|(s, _)| *s == scale) {
-            return Ok(t.clone());
-        }
-        let t = Rc::new(GBufferTargets::new(gpu, size)?);
-        *low = Some((scale, t.clone()));
-        Ok(t)
     }
 
     /// The same frame with its receivers made on the CPU from the G-buffers' points mapped back

@@ -141,18 +141,16 @@ impl ResolvePass {
                 limit: PARAMS,
             });
         }
-        let make = || {
-            Ok(ResolveSlot {
-                params: gpu.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("resolve"),
-                    size: PARAMS,
-                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                    mapped_at_creation: false,
-                }),
-                bind: crate::Keyed::default(),
-            })
+        let make = || ResolveSlot {
+            params: gpu.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("resolve"),
+                size: PARAMS,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            bind: crate::Keyed::default(),
         };
-        let bind = self.slots.next(gpu, make, |slot| {
+        let bind = self.slots.next_or_own(gpu, make, |slot| {
             gpu.queue.write_buffer(&slot.params, 0, params);
             let key: Vec<wgpu::Texture> =
                 [&gbuffer.position, &acc.texture].into_iter().chain(extra.iter().map(|(_, t)| *t)).cloned().collect();
@@ -170,14 +168,14 @@ impl ResolvePass {
                     binding: *binding,
                     resource: wgpu::BindingResource::TextureView(view),
                 }));
-                Ok(gpu.create_bind_group(&wgpu::BindGroupDescriptor {
+                gpu.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("resolve"),
                     layout: &self.pipeline.get_bind_group_layout(0),
                     entries: &entries,
-                }))
-            })?;
-            Ok(bind.clone())
-        })?;
+                })
+            });
+            bind.clone()
+        });
         let clear = wgpu::LoadOp::Clear(wgpu::Color::WHITE);
         match call {
             Some(call) => crate::fullscreen::record_calls(encoder, &self.pipeline, &bind, target, clear, call),

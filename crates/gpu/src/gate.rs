@@ -186,18 +186,19 @@ impl Gate<'_> {
             // room for a few more calls than the first light had: later ones rarely grow it
             let args = buffer("gated arguments", bytes.max(256), usage);
             let params = buffer("gate", 16, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
-            Ok(GateSlot { args, params, bind: crate::Keyed::default() })
+            GateSlot { args, params, bind: crate::Keyed::default() }
         };
-        let fill = |slot: &mut GateSlot| {
+        // past the slots a submission may hold, a light's own resources (made for it alone)
+        let (args, bind) = self.stats.slots.next_or_own(gpu, make, |slot| {
             if slot.args.size() < bytes {
-                *slot = make()?;
+                *slot = make();
             }
             gpu.queue.write_buffer(&slot.args, 0, bytemuck::cast_slice(&words));
             gpu.queue.write_buffer(&slot.params, 0, bytemuck::cast_slice(&params));
             let key = (slot.args.clone(), self.stats.stats.clone(), weber.clone());
             let (args, params) = (slot.args.clone(), slot.params.clone());
             let bind = slot.bind.get(key, || {
-                Ok(gpu.create_bind_group(&wgpu::BindGroupDescriptor {
+                gpu.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("gate"),
                     layout: &self.stats.gate.get_bind_group_layout(0),
                     entries: &[
@@ -206,18 +207,10 @@ impl Gate<'_> {
                         wgpu::BindGroupEntry { binding: 2, resource: weber.as_entire_binding() },
                         wgpu::BindGroupEntry { binding: 3, resource: args.as_entire_binding() },
                     ],
-                }))
-            })?;
-            Ok((args, bind.clone()))
-        };
-        // past the slots a submission may hold, a light's own resources (made for it alone)
-        let (args, bind) = match self.stats.slots.next(gpu, make, fill) {
-            Ok(kept) => kept,
-            Err(_) => {
-                let mut own = make().expect("making buffers does not fail");
-                fill(&mut own).expect("a new slot is large enough")
-            }
-        };
+                })
+            });
+            (args, bind.clone())
+        });
         gpu.count_gate_pass();
         let mut pass =
             encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("gate"), timestamp_writes: None });

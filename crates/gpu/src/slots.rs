@@ -27,6 +27,16 @@ struct Inner<T> {
     epoch: u64,
 }
 
+impl<T> Inner<T> {
+    /// Slot `k` (at most one past the last made), made by `make` when it is new.
+    fn slot(&mut self, k: usize, make: impl FnOnce() -> T) -> &mut T {
+        if k == self.slots.len() {
+            self.slots.push(make());
+        }
+        &mut self.slots[k]
+    }
+}
+
 impl<T> Default for Slots<T> {
     fn default() -> Self {
         Self { inner: Mutex::new(Inner { slots: Vec::new(), next: 0, epoch: u64::MAX }) }
@@ -50,14 +60,32 @@ impl<T> Slots<T> {
     /// before.
     ///
     /// # Errors
-    /// [`GpuError::TooLarge`] past [`MAX_SLOTS_PER_SUBMISSION`] slots in one submission;
-    /// `make`'s and `f`'s errors.
-    pub fn next<R>(
-        &self,
-        gpu: &Gpu,
-        make: impl FnOnce() -> Result<T, GpuError>,
-        f: impl FnOnce(&mut T) -> Result<R, GpuError>,
-    ) -> Result<R, GpuError> {
+    /// [`GpuError::TooLarge`] past [`MAX_SLOTS_PER_SUBMISSION`] slots in one submission.
+    pub fn next<R>(&self, gpu: &Gpu, make: impl FnOnce() -> T, f: impl FnOnce(&mut T) -> R) -> Result<R, GpuError> {
+        let (mut inner, k) = self.claim(gpu);
+        let k = k.ok_or(GpuError::TooLarge {
+            what: "lights recorded in one submission (submit through Gpu::submit or call Gpu::mark_submitted)",
+            size: MAX_SLOTS_PER_SUBMISSION as u64 + 1,
+            limit: MAX_SLOTS_PER_SUBMISSION as u64,
+        })?;
+        Ok(f(inner.slot(k, make)))
+    }
+
+    /// As [`Slots::next`], but past [`MAX_SLOTS_PER_SUBMISSION`] slots `f` gets a slot of the
+    /// light's own, made for it and dropped after (correct, only not reused).
+    pub fn next_or_own<R>(&self, gpu: &Gpu, make: impl FnOnce() -> T, f: impl FnOnce(&mut T) -> R) -> R {
+        let (mut inner, k) = self.claim(gpu);
+        match k {
+            Some(k) => f(inner.slot(k, make)),
+            None => {
+                drop(inner);
+                f(&mut make())
+            }
+        }
+    }
+
+    /// The slots, locked, and the index of this submission's next one (`None` past the limit).
+    fn claim(&self, gpu: &Gpu) -> (std::sync::MutexGuard<'_, Inner<T>>, Option<usize>) {
         let mut inner = self.inner.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
         let epoch = gpu.epoch();
         if inner.epoch != epoch {
@@ -66,29 +94,10 @@ impl<T> Slots<T> {
         }
         let k = inner.next;
         if k >= MAX_SLOTS_PER_SUBMISSION {
-            return Err(GpuError::TooLarge {
-                what: "lights recorded in one submission (submit through Gpu::submit or call Gpu::mark_submitted)",
-                size: k as u64 + 1,
-                limit: MAX_SLOTS_PER_SUBMISSION as u64,
-            });
-        }
-        if k == inner.slots.len() {
-            let slot = make()?;
-            inner.slots.push(slot);
+            return (inner, None);
         }
         inner.next += 1;
-        f(&mut inner.slots[k])
-    }
-
-    /// As [`Slots::next`] with `make` and `f` that cannot fail: past
-    /// [`MAX_SLOTS_PER_SUBMISSION`] slots, `f` gets a slot of the light's own, made for it and
-    /// dropped after (correct, only not reused).
-    pub fn next_or_own<R>(&self, gpu: &Gpu, make: impl Fn() -> T, f: impl FnOnce(&mut T) -> R) -> R {
-        let mut f = Some(f);
-        match self.next(gpu, || Ok(make()), |slot| Ok(f.take().map(|f| f(slot)))) {
-            Ok(Some(r)) => r,
-            _ => (f.take().expect("not called when the slots refused"))(&mut make()),
-        }
+        (inner, Some(k))
     }
 
     /// Slots made so far.
@@ -113,22 +122,22 @@ impl<K, V> Default for Keyed<K, V> {
 
 impl<K: PartialEq, V> Keyed<K, V> {
     /// The value for `key`, made by `make` when the key differs from the last one.
+    pub fn get(&mut self, key: K, make: impl FnOnce() -> V) -> &V {
+        match self.try_get(key, || Ok::<V, std::convert::Infallible>(make())) {
+            Ok(v) => v,
+            Err(never) => match never {},
+        }
+    }
+
+    /// As [`Keyed::get`] with a `make` that can fail (then nothing is kept).
     ///
     /// # Errors
     /// `make`'s.
-    pub fn get(&mut self, key: K, make: impl FnOnce() -> Result<V, GpuError>) -> Result<&V, GpuError> {
+    pub fn try_get<E>(&mut self, key: K, make: impl FnOnce() -> Result<V, E>) -> Result<&V, E> {
         if self.entry.as_ref().is_none_or(|(k, _)| *k != key) {
             self.entry = Some((key, make()?));
         }
         Ok(&self.entry.as_ref().expect("just set").1)
-    }
-
-    /// As [`Keyed::get`] with a `make` that cannot fail.
-    pub fn get_or_make(&mut self, key: K, make: impl FnOnce() -> V) -> &V {
-        if self.entry.as_ref().is_none_or(|(k, _)| *k != key) {
-            self.entry = Some((key, make()));
-        }
-        &self.entry.as_ref().expect("just set").1
     }
 }
 
@@ -141,12 +150,10 @@ mod tests {
         let mut k: Keyed<u32, u32> = Keyed::default();
         let mut made = 0;
         for key in [1, 1, 2, 2, 1] {
-            let v = *k
-                .get(key, || {
-                    made += 1;
-                    Ok(key * 10)
-                })
-                .unwrap();
+            let v = *k.get(key, || {
+                made += 1;
+                key * 10
+            });
             assert_eq!(v, key * 10);
         }
         assert_eq!(made, 3);

@@ -9,9 +9,9 @@ fn take(gpu: &Gpu, slots: &Slots<u32>, made: &mut u32) -> Result<u32, GpuError> 
         gpu,
         || {
             *made += 1;
-            Ok(*made)
+            *made
         },
-        |slot| Ok(*slot),
+        |slot| *slot,
     )
 }
 

@@ -684,17 +684,15 @@ impl Wedges {
                     mapped_at_creation: false,
                 })
             };
-            Ok(LightSlot {
+            LightSlot {
                 uniform: buffer("wedge build", std::mem::size_of::<BuildUniform>() as u64, wgpu::BufferUsages::UNIFORM),
                 casters: buffer("wedge casters", caster_bytes, wgpu::BufferUsages::STORAGE),
                 view: buffer("wedge view", std::mem::size_of::<ViewUniform>() as u64, wgpu::BufferUsages::UNIFORM),
                 binds: gpu::Keyed::default(),
-            })
-        };
-        let binds = self.slots.next(gpu, make, |slot| {
-            if slot.casters.size() < caster_bytes {
-                *slot = make()?;
             }
+        };
+        // the casters' count never changes (`update_object` keeps it): every slot fits
+        let binds = self.slots.next_or_own(gpu, make, |slot| {
             gpu.queue.write_buffer(&slot.uniform, 0, bytemuck::bytes_of(&uniform));
             gpu.queue.write_buffer(&slot.casters, 0, bytemuck::cast_slice(&caster_words));
             gpu.queue.write_buffer(&slot.view, 0, bytemuck::bytes_of(&view));
@@ -723,10 +721,10 @@ impl Wedges {
                         wgpu::BindGroupEntry { binding: 4, resource: mesh.footprints.as_entire_binding() },
                     ],
                 });
-                Ok([classify, mark, scan, emit, footprint, volume, wedge])
-            })?;
-            Ok(binds.clone())
-        })?;
+                [classify, mark, scan, emit, footprint, volume, wedge]
+            });
+            binds.clone()
+        });
         let [classify, mark, scan, emit, footprint, volume_bind, wedge_bind] = binds;
         let binds = [classify, mark, scan, emit, footprint];
         let scratch = self.scratch(gpu, gb.size())?;

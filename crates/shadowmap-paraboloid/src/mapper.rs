@@ -579,7 +579,7 @@ impl ShadowMapper {
         let (view, bind) = self.focus_slots.next_or_own(gpu, make, |slot| {
             gpu.queue.write_buffer(&slot.params, 0, bytemuck::bytes_of(&params));
             let (buffer, view) = (slot.params.clone(), slot.view.clone());
-            let bind = slot.bind.get_or_make(stats.buffer().clone(), || {
+            let bind = slot.bind.get(stats.buffer().clone(), || {
                 gpu.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("orthographic focus"),
                     layout: &self.focus.get_bind_group_layout(0),
@@ -886,7 +886,7 @@ impl ShadowMapper {
             );
             let buffer = slot.params.clone();
             slot.bind
-                .get_or_make(key, || {
+                .get(key, || {
                     let position = gbuffer.position.create_view(&Default::default());
                     let normal = gbuffer.geometric_normal.create_view(&Default::default());
                     let shadow = map.texture.create_view(&wgpu::TextureViewDescriptor {
