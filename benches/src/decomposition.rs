@@ -8,8 +8,8 @@ use envmap_sphere::EnvMap;
 use gpu::{
     Background, GBufferPass, GBufferTargets, Gpu, GpuError, JointBilateral, LightShape, MappedStats, PendingStats,
     PrefilterSettings, ReceiverReduction, Receivers, SceneGeometry, ShadeLight, ShadingPass, ShadowTechnique,
-    SpecularAmbient, SplitFrame, SplitPasses, SplitSettings, UpsamplePass, Visibility, WEBER_FRACTION, WeberInput,
-    indirect_camera, record_split, record_visibility,
+    SpecularAmbient, SplitFrame, SplitPasses, SplitSettings, SplitTargets, UpsamplePass, Visibility, WEBER_FRACTION,
+    WeberInput, indirect_camera, record_split, record_visibility,
 };
 use light_extract::Decomposition;
 use penumbra_wedge::{WedgeSettings, Wedges};
@@ -54,7 +54,8 @@ pub fn animation_pose(scene: &scene::Scene, object: usize, k: usize) -> glam::Af
         * glam::Affine3A::from_translation(-centre)
 }
 
-/// A frame's image (submitted, not waited for) and what its shadow passes did.
+/// A frame's image (submitted, not waited for) and what its shadow passes did. The image is
+/// the frame's own target: the next frame at the same scale renders into it.
 pub struct RenderedFrame {
     /// The HDR image.
     pub texture: wgpu::Texture,
@@ -88,6 +89,10 @@ impl RenderedFrame {
     }
 }
 
+/// What a frame at one scale renders into: the low-resolution G-buffer (none at scale 1)
+/// and the split frame's images.
+type ScaleTargets = (Option<GBufferTargets>, SplitTargets);
+
 /// Everything a frame needs that does not change between frames.
 pub struct Frame {
     /// The scene as built (objects at rest; [`Frame::set_transform`] moves them), its camera
@@ -105,10 +110,10 @@ pub struct Frame {
     maps: MapTechnique,
     // the receivers of the full- and the low-resolution G-buffer
     reductions: [ReceiverReduction; 2],
-    // what the frame renders into, made once: the full-resolution G-buffer, the low one (for
-    // the last scale asked) and the EnvDirects' visibility
+    // what the frame renders into, made once: the full-resolution G-buffer, the low one and
+    // the split frame's images (for the last scale asked) and the EnvDirects' visibility
     targets: GBufferTargets,
-    low_targets: RefCell<gpu::Keyed<u32, Rc<GBufferTargets>>>,
+    low_targets: RefCell<gpu::Keyed<u32, Rc<ScaleTargets>>>,
     direct_visibility: Visibility,
 }
 
@@ -251,6 +256,21 @@ impl Frame {
         Ok(frame)
     }
 
+    /// The low-resolution G-buffer's (none at scale 1) and the split frame's targets at
+    /// `scale`, made when the scale differs from the last one asked.
+    fn scale_targets(&self, gpu: &Gpu, scale: u32) -> Result<Rc<ScaleTargets>, GpuError> {
+        let settings = SplitSettings { indirect_scale: scale, upsample: JointBilateral::PAPER };
+        let size = (self.scene.camera.width, self.scene.camera.height);
+        let indirects = (self.decomposition.lights.len() - self.decomposition.directs()) as u32;
+        let make = || {
+            let low = indirect_camera(&self.scene.camera, &settings)?;
+            // at scale 1 the EnvIndirects are shaded from the full-resolution G-buffer
+            let gbuffer = (scale != 1).then(|| GBufferTargets::new(gpu, (low.width, low.height))).transpose()?;
+            Ok(Rc::new((gbuffer, SplitTargets::new(gpu, size, &settings, indirects)?)))
+        };
+        Ok(self.low_targets.borrow_mut().try_get(scale, make)?.clone())
+    }
+
     /// Submits both G-buffers (the low one at `low_camera` when `scale` is not 1) with their
     /// receivers reduced on the GPU: the frame's first submission.
     fn submit_reduced(
@@ -269,11 +289,10 @@ impl Frame {
         let low_gb = if scale == 1 {
             None
         } else {
-            let size = (low_camera.width, low_camera.height);
-            let low =
-                self.low_targets.borrow_mut().try_get(scale, || GBufferTargets::new(gpu, size).map(Rc::new))?.clone();
+            let low = self.scale_targets(gpu, scale)?;
             let view = GBufferPass::camera_view(&self.geometry, low_camera);
-            Some(self.gbuffer.record_into(gpu, &mut encoder, &self.geometry, &view, &low)?)
+            let targets = low.0.as_ref().ok_or_else(|| GpuError::Failed("no low G-buffer at scale 1".into()))?;
+            Some(self.gbuffer.record_into(gpu, &mut encoder, &self.geometry, &view, targets)?)
         };
         let mut pending = vec![self.reductions[0].record(gpu, &mut encoder, &gb, shapes, Some(weber))?];
         if let Some(l) = &low_gb {
@@ -322,6 +341,7 @@ impl Frame {
     ) -> Result<RenderedFrame, GpuError> {
         let d = &self.decomposition;
         let directs = d.directs();
+        let targets = self.scale_targets(gpu, settings.indirect_scale)?;
         let vis = &self.direct_visibility;
         vis.record_clear(encoder);
         let wedges: &dyn ShadowTechnique = &self.wedges;
@@ -342,6 +362,7 @@ impl Frame {
                 ambient: Some(&d.ambient_sh),
                 specular_ambient: Some(&self.specular),
                 background: Some(&self.background),
+                targets: Some(&targets.1),
             },
             &self.maps,
             settings,

@@ -50,7 +50,9 @@ pub use readback::{
 pub use receivers::{MappedStats, PendingStats, ReceiverReduction, ReceiverStats, WeberInput};
 pub use shade::{Background, HDR_FORMAT, ShadeLight, ShadeParams, ShadingPass, Visibility, read_hdr};
 pub use slots::{Keyed, MAX_SLOTS_PER_SUBMISSION, Slots};
-pub use split::{SplitFrame, SplitImage, SplitPasses, SplitSettings, indirect_camera, record_split, render_split};
+pub use split::{
+    SplitFrame, SplitImage, SplitPasses, SplitSettings, SplitTargets, indirect_camera, record_split, render_split,
+};
 pub use supersample::RotatedGrid;
 pub use target::{layer_view, render_target};
 pub use technique::{

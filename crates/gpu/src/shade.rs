@@ -170,6 +170,17 @@ pub struct ShadingPass {
     no_background: Background,
     // bound when a frame has no specular ambient (the shader then skips it)
     no_specular: SpecularAmbient,
+    // each shading of a submission's uniforms and bind group, kept from frame to frame
+    slots: crate::Slots<ShadeSlot>,
+}
+
+/// One shading's resources: its uniform, its lights and the bind group over them and what
+/// it reads (the lights' length, the materials, the G-buffer, visibility, background and
+/// specular textures).
+struct ShadeSlot {
+    uniform: wgpu::Buffer,
+    lights: wgpu::Buffer,
+    bind: crate::Keyed<(u64, [wgpu::Buffer; 2], [wgpu::Texture; 7]), wgpu::BindGroup>,
 }
 
 /// Output format of the shading pass: linear HDR radiance.
@@ -185,7 +196,12 @@ impl ShadingPass {
         let pipeline = crate::fullscreen::pipeline(gpu, "shade", &module, HDR_FORMAT);
         let none = PrefilteredMap { levels: vec![EnvMap::constant(1, 1, Vec3::ZERO)] };
         let no_specular = SpecularAmbient::upload(gpu, &none, &DfgTable { size: 1, values: vec![[0.0; 2]] })?;
-        Ok(Self { pipeline, no_background: Background::from_texels(gpu, (1, 1), &[[0.0; 4]])?, no_specular })
+        Ok(Self {
+            pipeline,
+            no_background: Background::from_texels(gpu, (1, 1), &[[0.0; 4]])?,
+            no_specular,
+            slots: crate::Slots::new(),
+        })
     }
 
     /// Shades `gbuffer` and returns the linear HDR image, row-major from the top-left.
@@ -227,8 +243,7 @@ impl ShadingPass {
     /// submitting.
     ///
     /// # Errors
-    /// [`GpuError::TooLarge`] when `visibility` has fewer layers than lights or the image is
-    /// too large.
+    /// As [`ShadingPass::record_into`]; [`GpuError::TooLarge`] for an image beyond the limits.
     pub fn record_texture(
         &self,
         gpu: &Gpu,
@@ -239,6 +254,31 @@ impl ShadingPass {
         visibility: &Visibility,
     ) -> Result<wgpu::Texture, GpuError> {
         let (w, h) = gbuffer.size();
+        let output = crate::target::render_target(gpu, "shaded", (w, h, 1), HDR_FORMAT)?;
+        self.record_into(gpu, encoder, geometry, gbuffer, params, visibility, &output)?;
+        Ok(output)
+    }
+
+    /// Records shading `gbuffer` into `output` (an [`HDR_FORMAT`] render target of its size,
+    /// e.g. [`crate::render_target`]'s, made once by the caller), without submitting. Its
+    /// uniforms and bind group are made once and rewritten frame after frame
+    /// ([`crate::Slots`]).
+    ///
+    /// # Errors
+    /// [`GpuError::TooLarge`] when `visibility` has fewer layers than lights;
+    /// [`GpuError::Failed`] for an `output` of another size or format.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_into(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        geometry: &SceneGeometry,
+        gbuffer: &GBuffer,
+        params: &ShadeParams,
+        visibility: &Visibility,
+        output: &wgpu::Texture,
+    ) -> Result<(), GpuError> {
+        let (w, h) = gbuffer.size();
         if (params.lights.len() as u32) > visibility.layers() {
             return Err(GpuError::TooLarge {
                 what: "lights for the visibility layers",
@@ -246,7 +286,14 @@ impl ShadingPass {
                 limit: visibility.layers().into(),
             });
         }
-        let output = crate::target::render_target(gpu, "shaded", (w, h, 1), HDR_FORMAT)?;
+        if (output.width(), output.height()) != (w, h) || output.format() != HDR_FORMAT {
+            return Err(GpuError::Failed(format!(
+                "shading a {w}x{h} G-buffer into a {}x{} {:?} target (wants {HDR_FORMAT:?})",
+                output.width(),
+                output.height(),
+                output.format()
+            )));
+        }
         let rays = gbuffer.view.rays();
         let sh =
             params.ambient.map_or([[0.0f32; 4]; 9], |a| a.irradiance_coefficients().map(|c| c.extend(0.0).to_array()));
@@ -278,44 +325,93 @@ impl ShadingPass {
         if lights.is_empty() {
             lights.push(bytemuck::Zeroable::zeroed());
         }
-        let uniform_buf = gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("shade params"),
-            contents: bytemuck::bytes_of(&uniform),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let light_buf = gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("lights"),
-            contents: bytemuck::cast_slice(&lights),
-            usage: wgpu::BufferUsages::STORAGE,
-        });
-        let views =
-            [&gbuffer.position, &gbuffer.normal, &gbuffer.geometric_normal].map(|t| t.create_view(&Default::default()));
-        let array =
-            wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() };
-        let vis_view = visibility.texture.create_view(&array);
+        let light_bytes: &[u8] = bytemuck::cast_slice(&lights);
         let specular = params.specular_ambient.unwrap_or(&self.no_specular);
-        let levels_view = specular.levels.create_view(&array);
-        let background_view = background.create_view(&array);
-        let table_view = specular.table.create_view(&Default::default());
-        let bind = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("shade"),
-            layout: &self.pipeline.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: uniform_buf.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: light_buf.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: geometry.materials.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&views[0]) },
-                wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&views[1]) },
-                wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&views[2]) },
-                wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::TextureView(&vis_view) },
-                wgpu::BindGroupEntry { binding: 7, resource: wgpu::BindingResource::TextureView(&background_view) },
-                wgpu::BindGroupEntry { binding: 8, resource: wgpu::BindingResource::TextureView(&levels_view) },
-                wgpu::BindGroupEntry { binding: 9, resource: wgpu::BindingResource::TextureView(&table_view) },
-            ],
+        let textures = [
+            gbuffer.position.clone(),
+            gbuffer.normal.clone(),
+            gbuffer.geometric_normal.clone(),
+            visibility.texture.clone(),
+            background.clone(),
+            specular.levels.clone(),
+            specular.table.clone(),
+        ];
+        let make = || ShadeSlot {
+            uniform: gpu.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("shade params"),
+                size: std::mem::size_of::<ShadeUniform>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            lights: gpu.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("lights"),
+                size: (light_bytes.len() as u64).max(256).next_power_of_two(),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            bind: crate::Keyed::default(),
+        };
+        // past the slots a submission may hold, this shading's own (made for it alone)
+        let bind = self.slots.next_or_own(gpu, make, |slot| {
+            gpu.queue.write_buffer(&slot.uniform, 0, bytemuck::bytes_of(&uniform));
+            crate::slots::write_grown(gpu, &mut slot.lights, "lights", wgpu::BufferUsages::STORAGE, light_bytes);
+            let bytes = light_bytes.len() as u64;
+            let key = (bytes, [slot.lights.clone(), geometry.materials.clone()], textures.clone());
+            let (uniform, light_buf) = (&slot.uniform, &slot.lights);
+            slot.bind
+                .get(key, || {
+                    let views = [&textures[0], &textures[1], &textures[2]].map(|t| t.create_view(&Default::default()));
+                    let array = wgpu::TextureViewDescriptor {
+                        dimension: Some(wgpu::TextureViewDimension::D2Array),
+                        ..Default::default()
+                    };
+                    let vis_view = textures[3].create_view(&array);
+                    let background_view = textures[4].create_view(&array);
+                    let levels_view = textures[5].create_view(&array);
+                    let table_view = textures[6].create_view(&Default::default());
+                    gpu.create_bind_group(&wgpu::BindGroupDescriptor {
+                        label: Some("shade"),
+                        layout: &self.pipeline.get_bind_group_layout(0),
+                        entries: &[
+                            wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
+                            wgpu::BindGroupEntry { binding: 1, resource: crate::slots::binding_of(light_buf, bytes) },
+                            wgpu::BindGroupEntry { binding: 2, resource: geometry.materials.as_entire_binding() },
+                            wgpu::BindGroupEntry {
+                                binding: 3,
+                                resource: wgpu::BindingResource::TextureView(&views[0]),
+                            },
+                            wgpu::BindGroupEntry {
+                                binding: 4,
+                                resource: wgpu::BindingResource::TextureView(&views[1]),
+                            },
+                            wgpu::BindGroupEntry {
+                                binding: 5,
+                                resource: wgpu::BindingResource::TextureView(&views[2]),
+                            },
+                            wgpu::BindGroupEntry {
+                                binding: 6,
+                                resource: wgpu::BindingResource::TextureView(&vis_view),
+                            },
+                            wgpu::BindGroupEntry {
+                                binding: 7,
+                                resource: wgpu::BindingResource::TextureView(&background_view),
+                            },
+                            wgpu::BindGroupEntry {
+                                binding: 8,
+                                resource: wgpu::BindingResource::TextureView(&levels_view),
+                            },
+                            wgpu::BindGroupEntry {
+                                binding: 9,
+                                resource: wgpu::BindingResource::TextureView(&table_view),
+                            },
+                        ],
+                    })
+                })
+                .clone()
         });
         let out_view = output.create_view(&Default::default());
         crate::fullscreen::record(encoder, &self.pipeline, &bind, &out_view, wgpu::LoadOp::Clear(wgpu::Color::BLACK));
-        Ok(output)
+        Ok(())
     }
 }
 

@@ -107,6 +107,33 @@ impl<T> Slots<T> {
     }
 }
 
+/// Writes `data` into `buffer` with `queue.write_buffer`, first replacing the buffer with a
+/// larger one (of `usage` and `COPY_DST`, a power of two of at least 256 bytes) when it does
+/// not fit: a slot's variable-length data (lights, arguments) grows to the largest frame's and
+/// stays there.
+pub(crate) fn write_grown(gpu: &Gpu, buffer: &mut wgpu::Buffer, label: &str, usage: wgpu::BufferUsages, data: &[u8]) {
+    let bytes = data.len() as u64;
+    if buffer.size() < bytes {
+        *buffer = gpu.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: bytes.max(256).next_power_of_two(),
+            usage: usage | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+    }
+    gpu.queue.write_buffer(buffer, 0, data);
+}
+
+/// A binding of the first `bytes` of `buffer` (at least 4): what a grown buffer binds, so
+/// that shaders see the data's length, not the buffer's.
+pub(crate) fn binding_of(buffer: &wgpu::Buffer, bytes: u64) -> wgpu::BindingResource<'_> {
+    wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+        buffer,
+        offset: 0,
+        size: std::num::NonZeroU64::new(bytes.clamp(4, buffer.size())),
+    })
+}
+
 /// A value kept with the resources it was made from, made again when they change: a bind
 /// group with the textures and buffers it binds.
 #[derive(Debug)]

@@ -47,6 +47,46 @@ pub struct SplitFrame<'a> {
     pub specular_ambient: Option<&'a SpecularAmbient>,
     /// What misses see.
     pub background: Option<&'a Background>,
+    /// What the frame renders into, made once by the caller ([`SplitTargets::new`]); `None`:
+    /// new textures for this frame alone.
+    pub targets: Option<&'a SplitTargets>,
+}
+
+/// What a split frame renders into, made once per size: the EnvDirects' shaded image, the
+/// EnvIndirects' visibility and shaded image at their resolution, and the output. A frame
+/// rendered into them is overwritten by the next one.
+pub struct SplitTargets {
+    base: wgpu::Texture,
+    indirect_visibility: Visibility,
+    shaded: wgpu::Texture,
+    output: wgpu::Texture,
+}
+
+impl SplitTargets {
+    /// Targets for frames of `size` pixels with `indirects` EnvIndirects drawn as `settings`
+    /// says.
+    ///
+    /// # Errors
+    /// [`GpuError::Failed`] for a scale that does not divide `size`; [`GpuError::TooLarge`]
+    /// beyond the adapter's limits.
+    pub fn new(gpu: &Gpu, size: (u32, u32), settings: &SplitSettings, indirects: u32) -> Result<Self, GpuError> {
+        let (lw, lh) = indirect_size(size, settings)?;
+        let target = |label, (w, h)| crate::target::render_target(gpu, label, (w, h, 1), crate::shade::HDR_FORMAT);
+        Ok(Self {
+            base: target("split base", size)?,
+            indirect_visibility: Visibility::allocate(gpu, lw, lh, indirects)?,
+            shaded: target("split indirects", (lw, lh))?,
+            output: target("split frame", size)?,
+        })
+    }
+
+    /// Whether frames of `size` with `indirects` EnvIndirects at `low` pixels render into these.
+    fn fits(&self, size: (u32, u32), low: (u32, u32), indirects: u32) -> bool {
+        let v = &self.indirect_visibility.texture;
+        (self.output.width(), self.output.height()) == size
+            && (v.width(), v.height()) == low
+            && self.indirect_visibility.layers() == indirects.max(1)
+    }
 }
 
 /// The passes a split frame uses, built once.
@@ -173,7 +213,23 @@ pub fn record_split(
     }
     let (directs, indirects) = frame.lights.split_at(frame.directs);
     let indirect_shapes = &frame.shapes[frame.directs..];
-    let base = passes.shading.record_texture(
+    let (lw, lh) = low.gbuffer.size();
+    let own;
+    let targets = match frame.targets {
+        Some(t) if t.fits(gb.size(), (lw, lh), indirects.len() as u32) => t,
+        Some(_) => {
+            return Err(GpuError::Failed(format!(
+                "split targets made for another size or light count than {:?} with {} EnvIndirects at {lw}x{lh}",
+                gb.size(),
+                indirects.len()
+            )));
+        }
+        None => {
+            own = SplitTargets::new(gpu, gb.size(), settings, indirects.len() as u32)?;
+            &own
+        }
+    };
+    passes.shading.record_into(
         gpu,
         encoder,
         geometry,
@@ -185,9 +241,9 @@ pub fn record_split(
             specular_ambient: frame.specular_ambient,
         },
         direct_visibility,
+        &targets.base,
     )?;
-    let (lw, lh) = low.gbuffer.size();
-    let visibility = Visibility::allocate(gpu, lw, lh, indirects.len() as u32)?;
+    let visibility = &targets.indirect_visibility;
     visibility.record_clear(encoder);
     // the directs count towards what a receiver already gets
     let mut negligible = match low_negligible {
@@ -195,14 +251,15 @@ pub fn record_split(
         None => weber_negligible(low, frame.lights, frame.ambient, WEBER_FRACTION),
     };
     let negligible = if negligible.len() >= frame.directs { negligible.split_off(frame.directs) } else { Vec::new() };
-    let indirect_reports = record_visibility(gpu, encoder, indirect, low, indirect_shapes, &negligible, &visibility)?;
-    let shaded = passes.shading.record_texture(
+    let indirect_reports = record_visibility(gpu, encoder, indirect, low, indirect_shapes, &negligible, visibility)?;
+    passes.shading.record_into(
         gpu,
         encoder,
         geometry,
         low.gbuffer,
         &ShadeParams { lights: indirects, ..Default::default() },
-        &visibility,
+        visibility,
+        &targets.shaded,
     )?;
     // at scale 1 the pass with a 1 x 1 window is the plain sum
     let upsample = if settings.indirect_scale == 1 {
@@ -210,6 +267,15 @@ pub fn record_split(
     } else {
         settings.upsample
     };
-    let texture = passes.upsample.record(gpu, encoder, geometry, (low.gbuffer, &shaded), (gb, &base), &upsample)?;
+    passes.upsample.record_into(
+        gpu,
+        encoder,
+        geometry,
+        (low.gbuffer, &targets.shaded),
+        (gb, &targets.base),
+        &upsample,
+        &targets.output,
+    )?;
+    let texture = targets.output.clone();
     Ok(SplitImage { texture, indirect_reports, indirect_size: (lw, lh) })
 }

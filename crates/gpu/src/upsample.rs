@@ -67,6 +67,14 @@ struct Uniform {
 /// The upsampling pass: pipeline built once.
 pub struct UpsamplePass {
     pipeline: wgpu::RenderPipeline,
+    // each upsampling of a submission's uniform and bind group, kept from frame to frame
+    slots: crate::Slots<UpsampleSlot>,
+}
+
+/// One upsampling's uniform and the bind group over it, the materials and the six textures.
+struct UpsampleSlot {
+    uniform: wgpu::Buffer,
+    bind: crate::Keyed<(wgpu::Buffer, [wgpu::Texture; 6]), wgpu::BindGroup>,
 }
 
 impl UpsamplePass {
@@ -75,7 +83,10 @@ impl UpsamplePass {
     pub fn new(gpu: &Gpu) -> Self {
         let module =
             crate::shader::module(&gpu.device, "upsample", include_str!("../../../shaders/gpu/upsample.wgsl"), &[]);
-        Self { pipeline: crate::fullscreen::pipeline(gpu, "upsample", &module, crate::shade::HDR_FORMAT) }
+        Self {
+            pipeline: crate::fullscreen::pipeline(gpu, "upsample", &module, crate::shade::HDR_FORMAT),
+            slots: crate::Slots::new(),
+        }
     }
 
     /// `base` + `low` upsampled: `low` was shaded from `low_gb`, whose size is `high_gb`'s
@@ -97,12 +108,35 @@ impl UpsamplePass {
         Ok(output)
     }
 
-    /// Records [`UpsamplePass::render`] into `encoder` without submitting.
+    /// Records [`UpsamplePass::render`] into `encoder` without submitting, into a new texture.
     ///
     /// # Errors
-    /// [`GpuError::Failed`] for sizes that are not an integer factor apart, a non-positive
-    /// sigma or a radius over [`JointBilateral::MAX_RADIUS`]; an image beyond the limits.
+    /// As [`UpsamplePass::record_into`]; an image beyond the limits.
     pub fn record(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        geometry: &SceneGeometry,
+        low: (&GBuffer, &wgpu::Texture),
+        high: (&GBuffer, &wgpu::Texture),
+        settings: &JointBilateral,
+    ) -> Result<wgpu::Texture, GpuError> {
+        let (hw, hh) = high.0.size();
+        let output = crate::target::render_target(gpu, "upsampled", (hw, hh, 1), crate::shade::HDR_FORMAT)?;
+        self.record_into(gpu, encoder, geometry, low, high, settings, &output)?;
+        Ok(output)
+    }
+
+    /// Records [`UpsamplePass::render`] into `encoder` without submitting, into `output` (an
+    /// [`crate::HDR_FORMAT`] render target of the high G-buffer's size, made once by the
+    /// caller). Its uniform and bind group are made once and rewritten frame after frame.
+    ///
+    /// # Errors
+    /// [`GpuError::Failed`] for sizes that are not an integer factor apart, an `output` of
+    /// another size or format, a non-positive sigma or a radius over
+    /// [`JointBilateral::MAX_RADIUS`].
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_into(
         &self,
         gpu: &Gpu,
         encoder: &mut wgpu::CommandEncoder,
@@ -110,7 +144,8 @@ impl UpsamplePass {
         (low_gb, low): (&GBuffer, &wgpu::Texture),
         (high_gb, base): (&GBuffer, &wgpu::Texture),
         settings: &JointBilateral,
-    ) -> Result<wgpu::Texture, GpuError> {
+        output: &wgpu::Texture,
+    ) -> Result<(), GpuError> {
         let (lw, lh) = low_gb.size();
         let (hw, hh) = high_gb.size();
         let factor = hw / lw.max(1);
@@ -142,27 +177,50 @@ impl UpsamplePass {
             .map(|v| if v == f32::MAX { 0.0 } else { v }),
             info: [factor, s.radius, lw, lh],
         };
-        let buffer = gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("upsample params"),
-            contents: bytemuck::bytes_of(&uniform),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let views = [&low_gb.position, &low_gb.normal, low, &high_gb.position, &high_gb.normal, base]
-            .map(|t| t.create_view(&Default::default()));
-        let mut entries = vec![
-            wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 1, resource: geometry.materials.as_entire_binding() },
-        ];
-        for (k, v) in views.iter().enumerate() {
-            entries
-                .push(wgpu::BindGroupEntry { binding: 2 + k as u32, resource: wgpu::BindingResource::TextureView(v) });
+        if (output.width(), output.height()) != (hw, hh) || output.format() != crate::shade::HDR_FORMAT {
+            return Err(GpuError::Failed(format!(
+                "upsampling into a {}x{} {:?} target: wants {hw}x{hh} {:?}",
+                output.width(),
+                output.height(),
+                output.format(),
+                crate::shade::HDR_FORMAT
+            )));
         }
-        let bind = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("upsample"),
-            layout: &self.pipeline.get_bind_group_layout(0),
-            entries: &entries,
+        let textures =
+            [&low_gb.position, &low_gb.normal, low, &high_gb.position, &high_gb.normal, base].map(Clone::clone);
+        let make = || UpsampleSlot {
+            uniform: gpu.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("upsample params"),
+                size: std::mem::size_of::<Uniform>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            bind: crate::Keyed::default(),
+        };
+        let bind = self.slots.next_or_own(gpu, make, |slot| {
+            gpu.queue.write_buffer(&slot.uniform, 0, bytemuck::bytes_of(&uniform));
+            let uniform = &slot.uniform;
+            slot.bind
+                .get((geometry.materials.clone(), textures.clone()), || {
+                    let views = textures.each_ref().map(|t| t.create_view(&Default::default()));
+                    let mut entries = vec![
+                        wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 1, resource: geometry.materials.as_entire_binding() },
+                    ];
+                    for (k, v) in views.iter().enumerate() {
+                        entries.push(wgpu::BindGroupEntry {
+                            binding: 2 + k as u32,
+                            resource: wgpu::BindingResource::TextureView(v),
+                        });
+                    }
+                    gpu.create_bind_group(&wgpu::BindGroupDescriptor {
+                        label: Some("upsample"),
+                        layout: &self.pipeline.get_bind_group_layout(0),
+                        entries: &entries,
+                    })
+                })
+                .clone()
         });
-        let output = crate::target::render_target(gpu, "upsampled", (hw, hh, 1), crate::shade::HDR_FORMAT)?;
         crate::fullscreen::record(
             encoder,
             &self.pipeline,
@@ -170,6 +228,6 @@ impl UpsamplePass {
             &output.create_view(&Default::default()),
             wgpu::LoadOp::Clear(wgpu::Color::BLACK),
         );
-        Ok(output)
+        Ok(())
     }
 }

@@ -165,6 +165,7 @@ fn render_with(scene: &Scene, settings: &SplitSettings, technique: &dyn ShadowTe
             ambient: Some(&f.ambient),
             specular_ambient: None,
             background: None,
+            targets: None,
         },
         technique,
         settings,

@@ -205,6 +205,7 @@ fn frame(
             ambient: Some(&d.ambient_sh),
             specular_ambient: input.specular,
             background: Some(input.background),
+            targets: None,
         },
         technique,
         &SplitSettings { indirect_scale: setting.indirect_scale * input.supersample, upsample: JointBilateral::PAPER },

@@ -183,6 +183,7 @@ pub(super) fn gpu_render(
             ambient: Some(&d.ambient_sh),
             specular_ambient: specular.as_ref(),
             background: Some(&background),
+            targets: None,
         };
         let upsample_pass = UpsamplePass::new(gpu);
         let split_passes = SplitPasses { gbuffer: &passes.gbuffer, shading: pass, upsample: &upsample_pass };
