@@ -337,18 +337,14 @@ impl ShadingPass {
             specular.table.clone(),
         ];
         let make = || ShadeSlot {
-            uniform: gpu.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("shade params"),
-                size: std::mem::size_of::<ShadeUniform>() as u64,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }),
-            lights: gpu.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("lights"),
-                size: (light_bytes.len() as u64).max(256).next_power_of_two(),
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }),
+            uniform: crate::slots::writable_buffer(
+                gpu,
+                "shade params",
+                wgpu::BufferUsages::UNIFORM,
+                std::mem::size_of::<ShadeUniform>() as u64,
+            ),
+            // grown to the frame's lights by its first write
+            lights: crate::slots::writable_buffer(gpu, "lights", wgpu::BufferUsages::STORAGE, 256),
             bind: crate::Keyed::default(),
         };
         // past the slots a submission may hold, this shading's own (made for it alone)

@@ -112,16 +112,21 @@ impl<T> Slots<T> {
 /// not fit: a slot's variable-length data (lights, arguments) grows to the largest frame's and
 /// stays there.
 pub(crate) fn write_grown(gpu: &Gpu, buffer: &mut wgpu::Buffer, label: &str, usage: wgpu::BufferUsages, data: &[u8]) {
-    let bytes = data.len() as u64;
-    if buffer.size() < bytes {
-        *buffer = gpu.create_buffer(&wgpu::BufferDescriptor {
-            label: Some(label),
-            size: bytes.max(256).next_power_of_two(),
-            usage: usage | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+    if buffer.size() < data.len() as u64 {
+        *buffer = writable_buffer(gpu, label, usage, (data.len() as u64).max(256).next_power_of_two());
     }
     gpu.queue.write_buffer(buffer, 0, data);
+}
+
+/// A `size`-byte buffer of `usage` that `queue.write_buffer` can rewrite (`COPY_DST`): a slot's
+/// uniform, or the first of its grown buffers.
+pub(crate) fn writable_buffer(gpu: &Gpu, label: &str, usage: wgpu::BufferUsages, size: u64) -> wgpu::Buffer {
+    gpu.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size,
+        usage: usage | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
 }
 
 /// A binding of the first `bytes` of `buffer` (at least 4): what a grown buffer binds, so

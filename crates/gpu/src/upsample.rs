@@ -189,12 +189,12 @@ impl UpsamplePass {
         let textures =
             [&low_gb.position, &low_gb.normal, low, &high_gb.position, &high_gb.normal, base].map(Clone::clone);
         let make = || UpsampleSlot {
-            uniform: gpu.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("upsample params"),
-                size: std::mem::size_of::<Uniform>() as u64,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }),
+            uniform: crate::slots::writable_buffer(
+                gpu,
+                "upsample params",
+                wgpu::BufferUsages::UNIFORM,
+                std::mem::size_of::<Uniform>() as u64,
+            ),
             bind: crate::Keyed::default(),
         };
         let bind = self.slots.next_or_own(gpu, make, |slot| {
