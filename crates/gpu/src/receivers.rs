@@ -8,6 +8,7 @@ use crate::context::{Gpu, GpuError};
 use crate::gate::GpuStats;
 use crate::gbuffer::GBuffer;
 use crate::shade::ShadeLight;
+use crate::slots::{Keyed, binding_of, writable_buffer, write_grown};
 use crate::technique::LightShape;
 use envmap_sphere::Sh9;
 use glam::Vec3;
@@ -90,6 +91,38 @@ struct Buffers {
     skipped: wgpu::Buffer,
 }
 
+/// What a reduction writes at each record, and the bind groups over it, made once and rewritten
+/// with `queue.write_buffer` (one reduction holds one result at a time, so one set serves it).
+struct Uploads {
+    params: wgpu::Buffer,
+    // grown to the largest frame's lights
+    lights: wgpu::Buffer,
+    weber_params: wgpu::Buffer,
+    weber_lights: wgpu::Buffer,
+    // reduce, finish, histogram, select: on (light bytes, [lights, partials], [position, normal])
+    binds: Keyed<(u64, [wgpu::Buffer; 2], [wgpu::Texture; 2]), [wgpu::BindGroup; 4]>,
+    // totals and greedy: on (light bytes, [lights, totals, skipped], [position, normal])
+    weber_binds: Keyed<(u64, [wgpu::Buffer; 3], [wgpu::Texture; 2]), [wgpu::BindGroup; 2]>,
+}
+
+/// Mappable buffers whose results were read (and unmapped), handed to the next record: a
+/// frame's readback makes no buffer once the frames in flight have theirs.
+type ReadPool = std::sync::Arc<std::sync::Mutex<Vec<wgpu::Buffer>>>;
+
+/// A mappable buffer of `size` bytes from `pool`, or a new one.
+fn pooled_read(gpu: &Gpu, pool: &ReadPool, label: &str, size: u64) -> wgpu::Buffer {
+    let mut pool = pool.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    match pool.iter().position(|b| b.size() == size) {
+        Some(k) => pool.swap_remove(k),
+        None => gpu.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        }),
+    }
+}
+
 /// The distances' radix select: a byte a pass.
 const DIGITS: u32 = 4;
 
@@ -108,6 +141,8 @@ pub struct ReceiverReduction {
     // the gated lights' resources, kept from frame to frame
     gate_slots: std::sync::Arc<crate::Slots<crate::gate::GateSlot>>,
     buffers: RefCell<Option<Buffers>>,
+    uploads: RefCell<Uploads>,
+    reads: ReadPool,
 }
 
 /// A reduction recorded, its result to be mapped once the encoder has run.
@@ -117,6 +152,8 @@ pub struct PendingStats {
     // Weber's result and its light count, when asked
     weber: Option<(wgpu::Buffer, usize)>,
     on_gpu: GpuStats,
+    // where `read` and Weber's go back once read
+    pool: ReadPool,
 }
 
 /// A reduction's result being mapped ([`PendingStats::map`]), to be read once its frame is done.
@@ -178,6 +215,20 @@ impl ReceiverReduction {
             gate: pipeline_of(&gate, "gate"),
             gate_slots: std::sync::Arc::default(),
             buffers: RefCell::new(None),
+            uploads: RefCell::new(Uploads {
+                params: writable_buffer(gpu, "receiver params", wgpu::BufferUsages::UNIFORM, 16),
+                lights: writable_buffer(gpu, "receiver lights", wgpu::BufferUsages::STORAGE, 256),
+                weber_params: writable_buffer(
+                    gpu,
+                    "weber params",
+                    wgpu::BufferUsages::UNIFORM,
+                    std::mem::size_of::<WeberParams>() as u64,
+                ),
+                weber_lights: writable_buffer(gpu, "weber lights", wgpu::BufferUsages::STORAGE, 256),
+                binds: Keyed::default(),
+                weber_binds: Keyed::default(),
+            }),
+            reads: ReadPool::default(),
         }
     }
 
@@ -248,51 +299,64 @@ impl ReceiverReduction {
             // storage bindings may not be empty
             shapes.push(bytemuck::Zeroable::zeroed());
         }
-        let buffer = |label, contents: &[u8], usage| {
-            gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
-        };
         let params = [w, h, lights.len() as u32, groups.0];
-        let params = buffer("receiver params", bytemuck::cast_slice(&params), wgpu::BufferUsages::UNIFORM);
-        let lights_buf = buffer("receiver lights", bytemuck::cast_slice(&shapes), wgpu::BufferUsages::STORAGE);
-        let position = gbuffer.position.create_view(&Default::default());
-        let normal = gbuffer.geometric_normal.create_view(&Default::default());
-        let reduce = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("receiver reduce"),
-            layout: &self.reduce.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&position) },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&normal) },
-                wgpu::BindGroupEntry { binding: 2, resource: params.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: lights_buf.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 4, resource: self.stats.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 5, resource: partials.as_entire_binding() },
-            ],
-        });
-        let finish = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("receiver finish"),
-            layout: &self.finish.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry { binding: 4, resource: self.stats.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 5, resource: partials.as_entire_binding() },
-            ],
-        });
-        let histogram_pass = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("receiver distance histogram"),
-            layout: &self.histogram_pass.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&position) },
-                wgpu::BindGroupEntry { binding: 2, resource: params.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 4, resource: self.stats.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 6, resource: self.histogram.as_entire_binding() },
-            ],
-        });
-        let select_digit = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("receiver distance select"),
-            layout: &self.select_digit.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry { binding: 4, resource: self.stats.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 6, resource: self.histogram.as_entire_binding() },
-            ],
+        let light_bytes: &[u8] = bytemuck::cast_slice(&shapes);
+        let mut uploads = self.uploads.borrow_mut();
+        let Uploads { params: params_buf, lights: lights_buf, binds, .. } = &mut *uploads;
+        gpu.queue.write_buffer(params_buf, 0, bytemuck::cast_slice(&params));
+        write_grown(gpu, lights_buf, "receiver lights", wgpu::BufferUsages::STORAGE, light_bytes);
+        let bytes = light_bytes.len() as u64;
+        let key = (
+            bytes,
+            [lights_buf.clone(), partials.clone()],
+            [gbuffer.position.clone(), gbuffer.geometric_normal.clone()],
+        );
+        let [reduce, finish, histogram_pass, select_digit] = binds.get(key, || {
+            let position = gbuffer.position.create_view(&Default::default());
+            let normal = gbuffer.geometric_normal.create_view(&Default::default());
+            let bind = |label, pipeline: &wgpu::ComputePipeline, entries: &[wgpu::BindGroupEntry<'_>]| {
+                gpu.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some(label),
+                    layout: &pipeline.get_bind_group_layout(0),
+                    entries,
+                })
+            };
+            let entry = |binding, resource| wgpu::BindGroupEntry { binding, resource };
+            let texture = |view| wgpu::BindingResource::TextureView(view);
+            [
+                bind(
+                    "receiver reduce",
+                    &self.reduce,
+                    &[
+                        entry(0, texture(&position)),
+                        entry(1, texture(&normal)),
+                        entry(2, params_buf.as_entire_binding()),
+                        entry(3, binding_of(lights_buf, bytes)),
+                        entry(4, self.stats.as_entire_binding()),
+                        entry(5, partials.as_entire_binding()),
+                    ],
+                ),
+                bind(
+                    "receiver finish",
+                    &self.finish,
+                    &[entry(4, self.stats.as_entire_binding()), entry(5, partials.as_entire_binding())],
+                ),
+                bind(
+                    "receiver distance histogram",
+                    &self.histogram_pass,
+                    &[
+                        entry(0, texture(&position)),
+                        entry(2, params_buf.as_entire_binding()),
+                        entry(4, self.stats.as_entire_binding()),
+                        entry(6, self.histogram.as_entire_binding()),
+                    ],
+                ),
+                bind(
+                    "receiver distance select",
+                    &self.select_digit,
+                    &[entry(4, self.stats.as_entire_binding()), entry(6, self.histogram.as_entire_binding())],
+                ),
+            ]
         });
         encoder.clear_buffer(&self.stats, 0, None);
         encoder.clear_buffer(&self.histogram, 0, None);
@@ -300,27 +364,23 @@ impl ReceiverReduction {
             let mut pass = encoder
                 .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("receivers"), timestamp_writes: None });
             pass.set_pipeline(&self.reduce);
-            pass.set_bind_group(0, &reduce, &[]);
+            pass.set_bind_group(0, reduce, &[]);
             pass.dispatch_workgroups(groups.0, groups.1, 1);
             pass.set_pipeline(&self.finish);
-            pass.set_bind_group(0, &finish, &[]);
+            pass.set_bind_group(0, finish, &[]);
             pass.dispatch_workgroups(1, 1, 1);
             for _ in 0..DIGITS {
                 pass.set_pipeline(&self.histogram_pass);
-                pass.set_bind_group(0, &histogram_pass, &[]);
+                pass.set_bind_group(0, histogram_pass, &[]);
                 pass.dispatch_workgroups(groups.0, groups.1, 1);
                 pass.set_pipeline(&self.select_digit);
-                pass.set_bind_group(0, &select_digit, &[]);
+                pass.set_bind_group(0, select_digit, &[]);
                 pass.dispatch_workgroups(1, 1, 1);
             }
         }
-        let read = gpu.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("receiver stats read"),
-            size: ReceiverStats::BYTES,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let read = pooled_read(gpu, &self.reads, "receiver stats read", ReceiverStats::BYTES);
         encoder.copy_buffer_to_buffer(&self.stats, 0, &read, 0, ReceiverStats::BYTES);
+        drop(uploads);
         let weber = weber
             .map(|input| {
                 self.record_weber(gpu, encoder, gbuffer, input, (stride, columns, rows), (&totals, &skipped))
@@ -334,7 +394,7 @@ impl ReceiverReduction {
             first: 0,
             slots: self.gate_slots.clone(),
         };
-        Ok(PendingStats { read, lights: lights.len(), weber, on_gpu })
+        Ok(PendingStats { read, lights: lights.len(), weber, on_gpu, pool: self.reads.clone() })
     }
 
     /// Records Weber's passes and the copy of their result.
@@ -370,46 +430,49 @@ impl ReceiverReduction {
             info: [input.fraction, if input.ambient.is_some() { 1.0 } else { 0.0 }, columns as f32, 0.0],
             sh: input.ambient.map_or([[0.0; 4]; 9], |a| a.irradiance_coefficients().map(|c| c.extend(0.0).to_array())),
         };
-        let buffer = |label, contents: &[u8], usage| {
-            gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
-        };
-        let params = buffer("weber params", bytemuck::bytes_of(&params), wgpu::BufferUsages::UNIFORM);
-        let lights = buffer("weber lights", bytemuck::cast_slice(&lights), wgpu::BufferUsages::STORAGE);
-        let position = gbuffer.position.create_view(&Default::default());
-        let normal = gbuffer.geometric_normal.create_view(&Default::default());
-        let bind = |pipeline: &wgpu::ComputePipeline| {
-            gpu.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("weber"),
-                layout: &pipeline.get_bind_group_layout(0),
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&position) },
-                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&normal) },
-                    wgpu::BindGroupEntry { binding: 2, resource: params.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 3, resource: lights.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 4, resource: self.weber_state.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 5, resource: totals.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 6, resource: skipped.as_entire_binding() },
-                ],
-            })
-        };
-        let (totals_bind, greedy_bind) = (bind(&self.weber_totals), bind(&self.weber_greedy));
+        let light_bytes: &[u8] = bytemuck::cast_slice(&lights);
+        let mut uploads = self.uploads.borrow_mut();
+        let Uploads { weber_params, weber_lights, weber_binds, .. } = &mut *uploads;
+        gpu.queue.write_buffer(weber_params, 0, bytemuck::bytes_of(&params));
+        write_grown(gpu, weber_lights, "weber lights", wgpu::BufferUsages::STORAGE, light_bytes);
+        let bytes = light_bytes.len() as u64;
+        let key = (
+            bytes,
+            [weber_lights.clone(), totals.clone(), skipped.clone()],
+            [gbuffer.position.clone(), gbuffer.geometric_normal.clone()],
+        );
+        let [totals_bind, greedy_bind] = weber_binds.get(key, || {
+            let position = gbuffer.position.create_view(&Default::default());
+            let normal = gbuffer.geometric_normal.create_view(&Default::default());
+            let bind = |pipeline: &wgpu::ComputePipeline| {
+                gpu.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("weber"),
+                    layout: &pipeline.get_bind_group_layout(0),
+                    entries: &[
+                        wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&position) },
+                        wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&normal) },
+                        wgpu::BindGroupEntry { binding: 2, resource: weber_params.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 3, resource: binding_of(weber_lights, bytes) },
+                        wgpu::BindGroupEntry { binding: 4, resource: self.weber_state.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 5, resource: totals.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 6, resource: skipped.as_entire_binding() },
+                    ],
+                })
+            };
+            [bind(&self.weber_totals), bind(&self.weber_greedy)]
+        });
         encoder.clear_buffer(&self.weber_state, 0, None);
         {
             let mut pass = encoder
                 .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("weber"), timestamp_writes: None });
             pass.set_pipeline(&self.weber_totals);
-            pass.set_bind_group(0, &totals_bind, &[]);
+            pass.set_bind_group(0, totals_bind, &[]);
             pass.dispatch_workgroups((columns * rows).div_ceil(64).max(1), 1, 1);
             pass.set_pipeline(&self.weber_greedy);
-            pass.set_bind_group(0, &greedy_bind, &[]);
+            pass.set_bind_group(0, greedy_bind, &[]);
             pass.dispatch_workgroups(1, 1, 1);
         }
-        let read = gpu.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("weber read"),
-            size: WEBER_BYTES,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let read = pooled_read(gpu, &self.reads, "weber read", WEBER_BYTES);
         encoder.copy_buffer_to_buffer(&self.weber_state, 0, &read, 0, WEBER_BYTES);
         Ok(read)
     }
@@ -456,12 +519,20 @@ impl PendingStats {
             pending.iter().flat_map(|p| std::iter::once(&p.read).chain(p.weber.as_ref().map(|w| &w.0))).collect();
         let mut mapped = crate::readback::read_mapped_all(gpu, &buffers)?.into_iter();
         let mut out = Vec::with_capacity(pending.len());
-        for p in &pending {
+        for p in pending {
             let bytes = mapped.next().unwrap_or_default();
             let weber = p.weber.as_ref().map(|_| mapped.next().unwrap_or_default());
             out.push(p.decode(&bytes, weber.as_deref())?);
+            p.recycle();
         }
         Ok(out)
+    }
+
+    /// Hands the read (and unmapped) buffers back to their reduction's pool.
+    fn recycle(self) {
+        let mut pool = self.pool.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        pool.push(self.read);
+        pool.extend(self.weber.map(|w| w.0));
     }
 
     fn decode(&self, bytes: &[u8], weber: Option<&[u8]>) -> Result<ReceiverStats, GpuError> {
@@ -503,6 +574,8 @@ impl MappedStats {
         let mut bytes = self.mapping.finish(gpu)?.into_iter();
         let stats = bytes.next().unwrap_or_default();
         let weber = bytes.next();
-        self.pending.decode(&stats, weber.as_deref())
+        let stats = self.pending.decode(&stats, weber.as_deref());
+        self.pending.recycle();
+        stats
     }
 }

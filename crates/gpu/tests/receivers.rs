@@ -64,12 +64,15 @@ fn shade_lights(scale: f32) -> (Vec<ShadeLight>, Sh9) {
     (lights, sky)
 }
 
-fn compare(gpu: &Gpu, scene: &scene::Scene, lights: &[LightShape]) -> ReceiverStats {
-    compare_weber(gpu, scene, lights, &shade_lights(1.0))
+fn compare(gpu: &Gpu, reduction: &ReceiverReduction, scene: &scene::Scene, lights: &[LightShape]) -> ReceiverStats {
+    compare_weber(gpu, reduction, scene, lights, &shade_lights(1.0))
 }
 
+/// Reduces `scene`'s G-buffer with `reduction` (one reused from call to call: its uploads and
+/// bind groups follow the G-buffer, the image size and the lights) and checks it against the CPU.
 fn compare_weber(
     gpu: &Gpu,
+    reduction: &ReceiverReduction,
     scene: &scene::Scene,
     lights: &[LightShape],
     weber: &(Vec<ShadeLight>, Sh9),
@@ -78,7 +81,6 @@ fn compare_weber(
     let gb = GBufferPass::new(gpu).render(gpu, &geometry, &scene.camera).unwrap();
     let points = gb.read_points(gpu).unwrap();
     let cpu = Receivers::new(&gb, &points);
-    let reduction = ReceiverReduction::new(gpu);
     let mut encoder = gpu.encoder("receivers");
     let before = gpu.counters();
     let (shade, sky) = weber;
@@ -115,23 +117,33 @@ fn compare_weber(
 #[test]
 fn gpu_receiver_stats_equal_the_cpu_receivers() {
     let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
+    let reduction = ReceiverReduction::new(&gpu);
     let (mut outcomes, mut negligible) = (Vec::new(), Vec::new());
     for scale in [1e-3, 1.0, 1e3] {
         let s = scene(scale);
-        let stats = compare_weber(&gpu, &s, &lights(scale), &shade_lights(scale));
+        let stats = compare_weber(&gpu, &reduction, &s, &lights(scale), &shade_lights(scale));
         outcomes.extend(stats.faces);
         negligible.extend(stats.negligible);
     }
     // the ground alone: the lights from below face nothing
     let mut ground = scene(1.0);
     ground.objects.retain(|o| o.name == "ground");
-    outcomes.extend(compare(&gpu, &ground, &lights(1.0)).faces);
+    outcomes.extend(compare(&gpu, &reduction, &ground, &lights(1.0)).faces);
+    // another size, fewer lights and more Weber lights than before, with the same reduction
+    let mut small = scene(1.0);
+    (small.camera.width, small.camera.height) = (33, 129);
+    let (mut shade, sky) = shade_lights(1.0);
+    shade.extend(shade.clone());
+    compare_weber(&gpu, &reduction, &small, &lights(1.0)[..2], &(shade, sky));
     // not vacuous: some lights face a receiver and some face none
     assert!(outcomes.contains(&true) && outcomes.contains(&false), "{outcomes:?}");
     assert!(negligible.contains(&true) && negligible.contains(&false), "{negligible:?}");
     // twice the same frame: the same bits
     let s = scene(1.0);
-    assert_eq!(compare(&gpu, &s, &lights(1.0)), compare(&gpu, &s, &lights(1.0)));
+    assert_eq!(
+        compare(&gpu, &reduction, &s, &lights(1.0)),
+        compare(&gpu, &ReceiverReduction::new(&gpu), &s, &lights(1.0))
+    );
 }
 
 #[test]
@@ -140,7 +152,7 @@ fn a_camera_that_sees_nothing_has_no_receivers() {
     let mut s = scene(1.0);
     // looking up, away from everything
     s.camera.target = s.camera.eye + Vec3::new(0.0, 1.0, 0.01);
-    let stats = compare(&gpu, &s, &lights(1.0));
+    let stats = compare(&gpu, &ReceiverReduction::new(&gpu), &s, &lights(1.0));
     assert_eq!((stats.count, stats.bounds, stats.mean, stats.radius), (0, None, None, None));
     assert!(stats.faces.iter().all(|f| !f));
     let too_many = vec![LightShape::Distant { direction: Vec3::Y, half_angle: 0.0 }; ReceiverReduction::MAX_LIGHTS + 1];
@@ -158,12 +170,43 @@ fn weber_on_the_gpu_marks_nothing_under_non_finite_light() {
     if let ShadeLight::Distant { irradiance, .. } = &mut shade[0] {
         *irradiance = Vec3::splat(f32::INFINITY);
     }
-    let stats = compare_weber(&gpu, &s, &lights(1.0), &(shade, sky));
+    let stats = compare_weber(&gpu, &ReceiverReduction::new(&gpu), &s, &lights(1.0), &(shade, sky));
     assert!(stats.negligible.iter().all(|n| !n) && !stats.negligible.is_empty());
     // an f16-max sun is finite: the faint lights under it are negligible
     let (mut shade, sky) = shade_lights(1.0);
     if let ShadeLight::Distant { irradiance, .. } = &mut shade[0] {
         *irradiance = Vec3::splat(65504.0);
     }
-    assert!(compare_weber(&gpu, &s, &lights(1.0), &(shade, sky)).negligible.contains(&true));
+    assert!(
+        compare_weber(&gpu, &ReceiverReduction::new(&gpu), &s, &lights(1.0), &(shade, sky)).negligible.contains(&true)
+    );
+}
+
+#[test]
+fn a_reused_reduction_makes_nothing_after_its_first_record() {
+    // its uploads and bind groups are kept for the G-buffer they bind, its mapped results go
+    // back to a pool once read: a second frame's reduction creates no buffer and no bind group
+    let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
+    let s = scene(1.0);
+    let geometry = SceneGeometry::upload(&gpu, &s).unwrap();
+    let gb = GBufferPass::new(&gpu).render(&gpu, &geometry, &s.camera).unwrap();
+    let reduction = ReceiverReduction::new(&gpu);
+    let (shade, sky) = shade_lights(1.0);
+    let weber = WeberInput { lights: &shade, ambient: Some(&sky), fraction: WEBER_FRACTION };
+    let mut results = Vec::new();
+    let mut made = Vec::new();
+    for _ in 0..3 {
+        let before = gpu.counters();
+        let mut encoder = gpu.encoder("receivers");
+        let pending = reduction.record(&gpu, &mut encoder, &gb, &lights(1.0), Some(weber)).unwrap();
+        gpu.submit(encoder);
+        let mapped = pending.map(&gpu);
+        gpu.wait(None).unwrap();
+        results.push(mapped.finish(&gpu).unwrap());
+        let d = gpu.counters() - before;
+        made.push((d.buffers, d.bind_groups));
+    }
+    assert!(made[0].0 > 0 && made[0].1 > 0, "the first record makes its resources: {made:?}");
+    assert_eq!(&made[1..], &[(0, 0), (0, 0)], "{made:?}");
+    assert!(results.windows(2).all(|w| w[0] == w[1]), "{results:?}");
 }
