@@ -4,7 +4,9 @@
 //! bench `soft_shadows` times the techniques.
 
 use glam::Vec3;
-use gpu::{GBufferPass, Gpu, GpuError, LightShape, Receivers, SceneGeometry, ShadowTechnique, Visibility};
+use gpu::{
+    GBufferPass, Gpu, GpuError, LightShape, Receivers, SceneGeometry, ShadowTechnique, Visibility, render_visibility,
+};
 use penumbra_wedge::{WedgePath, WedgeSettings, Wedges};
 use ref_tracer::SceneBvh;
 use ref_tracer::visibility::{AreaLight, Weighting, area_light_visibility_refined};
@@ -145,8 +147,8 @@ impl Frame {
     ) -> Result<(Vec<f32>, gpu::ShadowPassReport), GpuError> {
         let (w, h) = self.gbuffer.size();
         let vis = Visibility::new(gpu, w, h, 1)?;
-        let report =
-            technique.write_visibility(gpu, &Receivers::new(&self.gbuffer, &self.points), light, &vis.layer(0))?;
+        let receivers = Receivers::new(&self.gbuffer, &self.points);
+        let report = render_visibility(gpu, technique, &receivers, std::slice::from_ref(light), &[], &vis)?.remove(0);
         Ok((vis.read(gpu, 0)?, report))
     }
 }

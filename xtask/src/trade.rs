@@ -250,7 +250,7 @@ pub fn run(args: &TradeArgs) -> Result<(), String> {
                 for scene in &env_scenes {
                     outln!("[{:>6.1} s] {scene} under {name}: truth", start.elapsed().as_secs_f64());
                     let case = Case::new(scene, name, map.clone(), &plan).map_err(e)?;
-                    run.rows.extend(trade::measure(&gpu, &passes, &case, &settings, &plan, &mut show).map_err(e)?);
+                    run.rows.extend(trade::measure(&gpu, &case, &settings, &plan, &mut show).map_err(e)?);
                 }
             }
             Unit::Point(scene) => {

@@ -20,6 +20,7 @@ mod gate;
 mod gbuffer;
 mod geometry;
 mod interleave;
+mod lit_frame;
 pub mod placement;
 mod readback;
 mod receivers;
@@ -44,6 +45,7 @@ pub use gbuffer::{
 };
 pub use geometry::{Chunk, SceneGeometry, ShadowGeometry, scene_triangles};
 pub use interleave::{InterleavePass, InterleavedFrame, MAX_SETS, interleave_set, interleave_tile, render_interleaved};
+pub use lit_frame::{FrameLights, FrameShadows, LitFrame, LitSettings, ReceiversFrom, RenderedFrame};
 pub use readback::{
     MappingRead, PendingRead, read_buffer, read_mapped, read_mapped_all, read_texture_f32, read_texture_rgba,
 };
@@ -56,7 +58,7 @@ pub use split::{
 pub use supersample::RotatedGrid;
 pub use target::{layer_view, render_target};
 pub use technique::{
-    LightShape, PrecomputedVisibility, Receivers, ShadowPassReport, ShadowTechnique, WEBER_FRACTION,
+    LightShape, LightStamps, PrecomputedVisibility, Receivers, ShadowPassReport, ShadowTechnique, WEBER_FRACTION,
     WEBER_MAX_RECEIVERS, culled_totals, record_visibility, render_visibility, skip_reasons, totals, weber_negligible,
 };
 pub use timer::Clock;

@@ -4,16 +4,15 @@
 //! joint-bilateral upsampled onto the first. What a light *is* (direct or indirect) comes from
 //! the extraction; this module only draws it.
 
-use crate::ambient::SpecularAmbient;
 use crate::context::{Gpu, GpuError};
 use crate::gbuffer::GBufferPass;
 use crate::geometry::SceneGeometry;
-use crate::shade::{Background, ShadeLight, ShadeParams, ShadingPass, Visibility};
+use crate::lit_frame::FrameLights;
+use crate::shade::{ShadeParams, ShadingPass, Visibility};
 use crate::technique::{
-    LightShape, Receivers, ShadowPassReport, ShadowTechnique, WEBER_FRACTION, record_visibility, weber_negligible,
+    Receivers, ShadowPassReport, ShadowTechnique, WEBER_FRACTION, record_visibility, weber_negligible,
 };
 use crate::upsample::{JointBilateral, UpsamplePass};
-use envmap_sphere::Sh9;
 
 /// How the EnvIndirects are drawn.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -32,21 +31,11 @@ impl Default for SplitSettings {
     }
 }
 
-/// The lights and ambient of one frame.
+/// The lights and ambient of one split frame, and what it renders into.
 #[derive(Clone, Copy)]
 pub struct SplitFrame<'a> {
-    /// Every light, the EnvDirects first.
-    pub lights: &'a [ShadeLight],
-    /// Their shapes, for shadow techniques, in the same order.
-    pub shapes: &'a [LightShape],
-    /// How many of `lights` are EnvDirects.
-    pub directs: usize,
-    /// Ambient SH9 (diffuse lobe), may be signed.
-    pub ambient: Option<&'a Sh9>,
-    /// The ambient on the specular lobe.
-    pub specular_ambient: Option<&'a SpecularAmbient>,
-    /// What misses see.
-    pub background: Option<&'a Background>,
+    /// Every light, the EnvDirects first, and what shades them beside.
+    pub lit: FrameLights<'a>,
     /// What the frame renders into, made once by the caller ([`SplitTargets::new`]); `None`:
     /// new textures for this frame alone.
     pub targets: Option<&'a SplitTargets>,
@@ -203,16 +192,16 @@ pub fn record_split(
             low.gbuffer.size()
         )));
     }
-    if frame.directs > frame.lights.len() || frame.shapes.len() != frame.lights.len() {
+    if frame.lit.directs > frame.lit.lights.len() || frame.lit.shapes.len() != frame.lit.lights.len() {
         return Err(GpuError::Failed(format!(
             "{} directs of {} lights ({} shapes)",
-            frame.directs,
-            frame.lights.len(),
-            frame.shapes.len()
+            frame.lit.directs,
+            frame.lit.lights.len(),
+            frame.lit.shapes.len()
         )));
     }
-    let (directs, indirects) = frame.lights.split_at(frame.directs);
-    let indirect_shapes = &frame.shapes[frame.directs..];
+    let (directs, indirects) = frame.lit.lights.split_at(frame.lit.directs);
+    let indirect_shapes = &frame.lit.shapes[frame.lit.directs..];
     let (lw, lh) = low.gbuffer.size();
     let own;
     let targets = match frame.targets {
@@ -236,9 +225,9 @@ pub fn record_split(
         gb,
         &ShadeParams {
             lights: directs,
-            ambient: frame.ambient,
-            background: frame.background,
-            specular_ambient: frame.specular_ambient,
+            ambient: frame.lit.ambient,
+            background: frame.lit.background,
+            specular_ambient: frame.lit.specular_ambient,
         },
         direct_visibility,
         &targets.base,
@@ -248,9 +237,10 @@ pub fn record_split(
     // the directs count towards what a receiver already gets
     let mut negligible = match low_negligible {
         Some(n) => n.to_vec(),
-        None => weber_negligible(low, frame.lights, frame.ambient, WEBER_FRACTION),
+        None => weber_negligible(low, frame.lit.lights, frame.lit.ambient, WEBER_FRACTION),
     };
-    let negligible = if negligible.len() >= frame.directs { negligible.split_off(frame.directs) } else { Vec::new() };
+    let negligible =
+        if negligible.len() >= frame.lit.directs { negligible.split_off(frame.lit.directs) } else { Vec::new() };
     let indirect_reports = record_visibility(gpu, encoder, indirect, low, indirect_shapes, &negligible, visibility)?;
     passes.shading.record_into(
         gpu,

@@ -7,8 +7,8 @@
 //! [`record_visibility`] is the frame loop: it records every light's passes into the caller's
 //! encoder, skipping lights that no visible receiver can see (no shadow pass for a light nobody
 //! sees) and those [`weber_negligible`] finds below Weber's 2 % at every visible receiver,
-//! together, and reports what it skipped. [`render_visibility`] is the same loop with each light
-//! submitted, waited for and timed on its own, for measurement.
+//! together, and reports what it skipped. [`render_visibility`] is the same loop measured: one
+//! submission, waited for, each light between timestamps of its own.
 
 use crate::context::{Gpu, GpuError};
 use crate::gate::{Gate, GpuStats};
@@ -195,8 +195,8 @@ pub struct ShadowPassReport {
 /// A GPU shadow technique: writes one light's visibility layer (1 lit, 0 shadowed) for a frame.
 ///
 /// [`ShadowTechnique::record`] is the real-time path: it records the light's passes into the
-/// caller's encoder and never submits, waits or maps. [`ShadowTechnique::write_visibility`]
-/// wraps it for measurement (one submission, waited for, timed).
+/// caller's encoder and never submits, waits or maps. [`render_visibility`] wraps it for
+/// measurement (every light of a frame in one submission, waited for, each light timed).
 pub trait ShadowTechnique {
     /// Name, e.g. `wedge_raster` or `pcss_2048`; validate's rows prefix it with `gpu_`.
     fn name(&self) -> String;
@@ -235,28 +235,6 @@ pub trait ShadowTechnique {
     /// GPU failures.
     fn read_counts(&self, _gpu: &Gpu, _reports: &mut [ShadowPassReport]) -> Result<(), GpuError> {
         Ok(())
-    }
-
-    /// [`ShadowTechnique::record`] in a submission of its own, waited for and timed: what
-    /// validate, the trade and the benches measure one light with.
-    ///
-    /// # Errors
-    /// As [`ShadowTechnique::record`]; GPU failures.
-    fn write_visibility(
-        &self,
-        gpu: &Gpu,
-        receivers: &Receivers,
-        light: &LightShape,
-        target: &wgpu::TextureView,
-    ) -> Result<ShadowPassReport, GpuError> {
-        let mut recorded = None;
-        let (time, clock) =
-            gpu.measure(|encoder| recorded = Some(self.record(gpu, encoder, receivers, light, None, target)))?;
-        let report = recorded.ok_or_else(|| GpuError::Failed(format!("{}: nothing recorded", self.name())))??;
-        let mut report = [ShadowPassReport { time, clock: Some(clock), ..report }];
-        self.read_counts(gpu, &mut report)?;
-        let [report] = report;
-        Ok(report)
     }
 }
 
@@ -323,17 +301,128 @@ pub fn record_visibility(
     negligible: &[bool],
     visibility: &Visibility,
 ) -> Result<Vec<ShadowPassReport>, GpuError> {
-    each_light(receivers, lights, negligible, visibility, |k, light| {
+    record_visibility_stamped(gpu, encoder, (technique, receivers), (lights, negligible), visibility, None)
+}
+
+/// [`record_visibility`] with light `k`'s passes between the k-th pair of `stamps`
+/// (measurement: [`LightStamps`]).
+pub(crate) fn record_visibility_stamped(
+    gpu: &Gpu,
+    encoder: &mut wgpu::CommandEncoder,
+    (technique, receivers): (&dyn ShadowTechnique, &Receivers),
+    (lights, negligible): (&[LightShape], &[bool]),
+    visibility: &Visibility,
+    stamps: Option<&LightStamps>,
+) -> Result<Vec<ShadowPassReport>, GpuError> {
+    let reports = each_light(receivers, lights, negligible, visibility, |k, light| {
         let gate = receivers.on_gpu.as_ref().map(|s| s.gate(k));
-        technique.record(gpu, encoder, receivers, light, gate, &visibility.layer(k))
-    })
+        if let Some(s) = stamps {
+            s.write(encoder, k as usize, 0);
+        }
+        let report = technique.record(gpu, encoder, receivers, light, gate, &visibility.layer(k));
+        if let Some(s) = stamps {
+            s.write(encoder, k as usize, 1);
+        }
+        report
+    })?;
+    // skipped lights' pairs are written too (nothing between them), so that every query resolves
+    if let Some(s) = stamps {
+        for (k, _) in reports.iter().enumerate().filter(|(_, r)| r.skipped.is_some()) {
+            s.write(encoder, k, 0);
+            s.write(encoder, k, 1);
+        }
+    }
+    Ok(reports)
+}
+
+/// Two GPU timestamps a light around its recorded passes: how measurement times each light of
+/// a frame recorded into one submission. Made per measured frame (measurement only).
+pub struct LightStamps {
+    set: wgpu::QuerySet,
+    resolve: wgpu::Buffer,
+    read: wgpu::Buffer,
+    lights: usize,
+}
+
+impl LightStamps {
+    /// Stamps for `lights` lights, `None` without timestamps inside encoders (or for none).
+    ///
+    /// # Errors
+    /// [`GpuError::TooLarge`] past the queries one set holds.
+    pub fn new(gpu: &Gpu, lights: usize) -> Result<Option<Self>, GpuError> {
+        let timestamps = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+        if !gpu.features.contains(timestamps) || lights == 0 {
+            return Ok(None);
+        }
+        let queries = 2 * lights as u64;
+        if queries > u64::from(wgpu::QUERY_SET_MAX_QUERIES) {
+            return Err(GpuError::TooLarge {
+                what: "lights timed in one submission",
+                size: lights as u64,
+                limit: u64::from(wgpu::QUERY_SET_MAX_QUERIES / 2),
+            });
+        }
+        let set = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
+            label: Some("per-light timestamps"),
+            ty: wgpu::QueryType::Timestamp,
+            count: queries as u32,
+        });
+        let buffer = |label, usage| {
+            gpu.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: 8 * queries,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        Ok(Some(Self {
+            set,
+            resolve: buffer("per-light timestamps", wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC),
+            read: buffer("per-light timestamps read", wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST),
+            lights,
+        }))
+    }
+
+    fn write(&self, encoder: &mut wgpu::CommandEncoder, light: usize, end: u32) {
+        if light < self.lights {
+            encoder.write_timestamp(&self.set, 2 * light as u32 + end);
+        }
+    }
+
+    /// Records the stamps' resolve and copy, after every light's passes.
+    pub fn record_resolve(&self, encoder: &mut wgpu::CommandEncoder) {
+        let queries = 2 * self.lights as u32;
+        encoder.resolve_query_set(&self.set, 0..queries, &self.resolve, 0);
+        encoder.copy_buffer_to_buffer(&self.resolve, 0, &self.read, 0, 8 * u64::from(queries));
+    }
+
+    /// The buffer the stamps are mapped from, once their submission has run.
+    #[must_use]
+    pub fn read_buffer(&self) -> &wgpu::Buffer {
+        &self.read
+    }
+
+    /// Puts each drawn light's time (between its two stamps, from the mapped `bytes`) into its
+    /// report, `reports[k]` being light k's.
+    pub fn apply(&self, gpu: &Gpu, bytes: &[u8], reports: &mut [ShadowPassReport]) {
+        let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(bytes);
+        let period = f64::from(gpu.queue.get_timestamp_period());
+        for (k, r) in reports.iter_mut().enumerate().take(self.lights) {
+            if r.skipped.is_some() || ticks.len() < 2 * k + 2 {
+                continue;
+            }
+            let ns = ticks[2 * k + 1].saturating_sub(ticks[2 * k]) as f64 * period;
+            r.time = Duration::from_nanos(ns as u64);
+            r.clock = Some(Clock::GpuTimestamps);
+        }
+    }
 }
 
 /// [`record_visibility`] measured: every light's passes recorded into one encoder between two
 /// GPU timestamps of its own, one submission, one wait; each report's `time` is its light's.
-/// Without timestamps inside encoders each light goes in a submission of its own, waited for
-/// and timed on the wall clock ([`ShadowTechnique::write_visibility`]). What validate, the trade
-/// and the benches measure a frame's lights with.
+/// Without timestamps inside encoders the same single submission is timed on the wall clock
+/// and each light gets an even share of it ([`Clock::WallTimeShare`]): there is no per-light
+/// submission. What validate, the trade and the benches measure a frame's lights with.
 ///
 /// # Errors
 /// As [`record_visibility`]; GPU failures.
@@ -345,56 +434,34 @@ pub fn render_visibility(
     negligible: &[bool],
     visibility: &Visibility,
 ) -> Result<Vec<ShadowPassReport>, GpuError> {
-    let timestamps = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
-    if !gpu.features.contains(timestamps) || lights.is_empty() {
-        return each_light(receivers, lights, negligible, visibility, |k, light| {
-            technique.write_visibility(gpu, receivers, light, &visibility.layer(k))
-        });
+    if lights.is_empty() {
+        return Ok(Vec::new());
     }
-    let queries = 2 * lights.len() as u32;
-    if queries > wgpu::QUERY_SET_MAX_QUERIES {
-        return Err(GpuError::TooLarge {
-            what: "lights timed in one submission",
-            size: lights.len() as u64,
-            limit: u64::from(wgpu::QUERY_SET_MAX_QUERIES / 2),
-        });
-    }
-    let set = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
-        label: Some("per-light timestamps"),
-        ty: wgpu::QueryType::Timestamp,
-        count: queries,
-    });
-    let bytes = 8 * u64::from(queries);
-    let buffer = |label, usage| {
-        gpu.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size: bytes, usage, mapped_at_creation: false })
-    };
-    let resolve = buffer("per-light timestamps", wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC);
-    let read = buffer("per-light timestamps read", wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
+    let stamps = LightStamps::new(gpu, lights.len())?;
     let mut encoder = gpu.encoder("lights, each timed");
-    let mut timed = Vec::with_capacity(lights.len());
-    let mut reports = each_light(receivers, lights, negligible, visibility, |k, light| {
-        encoder.write_timestamp(&set, 2 * k);
-        let gate = receivers.on_gpu.as_ref().map(|s| s.gate(k));
-        let report = technique.record(gpu, &mut encoder, receivers, light, gate, &visibility.layer(k));
-        encoder.write_timestamp(&set, 2 * k + 1);
-        timed.push(k as usize);
-        report
-    })?;
-    // skipped lights' slots are written too (nothing between them), so that every query resolves
-    for k in (0..lights.len()).filter(|k| !timed.contains(k)) {
-        encoder.write_timestamp(&set, 2 * k as u32);
-        encoder.write_timestamp(&set, 2 * k as u32 + 1);
+    let mut reports = record_visibility_stamped(
+        gpu,
+        &mut encoder,
+        (technique, receivers),
+        (lights, negligible),
+        visibility,
+        stamps.as_ref(),
+    )?;
+    if let Some(s) = &stamps {
+        s.record_resolve(&mut encoder);
     }
-    encoder.resolve_query_set(&set, 0..queries, &resolve, 0);
-    encoder.copy_buffer_to_buffer(&resolve, 0, &read, 0, bytes);
-    gpu.submit_and_wait(encoder)?;
+    let total = gpu.submit_timed(encoder)?;
     technique.read_counts(gpu, &mut reports)?;
-    let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&crate::readback::read_mapped(gpu, &read)?);
-    let period = f64::from(gpu.queue.get_timestamp_period());
-    for k in timed {
-        let ns = ticks[2 * k + 1].saturating_sub(ticks[2 * k]) as f64 * period;
-        reports[k].time = Duration::from_nanos(ns as u64);
-        reports[k].clock = Some(Clock::GpuTimestamps);
+    match &stamps {
+        Some(s) => s.apply(gpu, &crate::readback::read_mapped(gpu, s.read_buffer())?, &mut reports),
+        None => {
+            // the lights recorded together cannot be told apart: an even share each
+            let drawn = reports.iter().filter(|r| r.skipped.is_none()).count().max(1) as u32;
+            for r in reports.iter_mut().filter(|r| r.skipped.is_none()) {
+                r.time = total / drawn;
+                r.clock = Some(Clock::WallTimeShare);
+            }
+        }
     }
     Ok(reports)
 }
@@ -527,7 +594,8 @@ pub fn totals(reports: &[ShadowPassReport]) -> (Duration, usize, usize, u64) {
 pub struct PrecomputedVisibility {
     name: String,
     size: (u32, u32),
-    layers: Vec<(LightShape, Vec<f32>)>,
+    // per light, its values uploaded once and the bind group over them
+    layers: Vec<(LightShape, wgpu::BindGroup)>,
     pipeline: wgpu::RenderPipeline,
 }
 
@@ -548,6 +616,26 @@ impl PrecomputedVisibility {
         let module =
             crate::shader::module(&gpu.device, "upload", include_str!("../../../shaders/gpu/upload.wgsl"), &[]);
         let pipeline = crate::fullscreen::pipeline(gpu, "upload", &module, Visibility::FORMAT);
+        let buffer = |label, contents: &[u8], usage| {
+            gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+        };
+        let params = [size.0, size.1, 0, 0];
+        let params = buffer("upload params", bytemuck::cast_slice(&params), wgpu::BufferUsages::UNIFORM);
+        let layers = layers
+            .into_iter()
+            .map(|(light, values)| {
+                let values = buffer("upload values", bytemuck::cast_slice(&values), wgpu::BufferUsages::STORAGE);
+                let bind = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("upload"),
+                    layout: &pipeline.get_bind_group_layout(0),
+                    entries: &[
+                        wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 1, resource: values.as_entire_binding() },
+                    ],
+                });
+                (light, bind)
+            })
+            .collect();
         Ok(Self { name: name.into(), size, layers, pipeline })
     }
 }
@@ -570,7 +658,7 @@ impl ShadowTechnique for PrecomputedVisibility {
         gate: Option<Gate<'_>>,
         target: &wgpu::TextureView,
     ) -> Result<ShadowPassReport, GpuError> {
-        let Some((_, values)) = self.layers.iter().find(|(l, _)| l == light) else {
+        let Some((_, bind)) = self.layers.iter().find(|(l, _)| l == light) else {
             return Err(GpuError::Failed(format!("{}: no visibility for {light:?}", self.name)));
         };
         if receivers.gbuffer.size() != self.size {
@@ -581,23 +669,9 @@ impl ShadowTechnique for PrecomputedVisibility {
                 receivers.gbuffer.size()
             )));
         }
-        let params = [self.size.0, self.size.1, 0, 0];
-        let buffer = |label, contents: &[u8], usage| {
-            gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
-        };
-        let params = buffer("upload params", bytemuck::cast_slice(&params), wgpu::BufferUsages::UNIFORM);
-        let values = buffer("upload values", bytemuck::cast_slice(values), wgpu::BufferUsages::STORAGE);
-        let bind = gpu.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("upload"),
-            layout: &self.pipeline.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: values.as_entire_binding() },
-            ],
-        });
         let calls = crate::Calls::new(gpu, encoder, gate, vec![crate::Indirect::draw(0..3)]);
         let clear = wgpu::LoadOp::Clear(wgpu::Color::WHITE);
-        crate::fullscreen::record_calls(encoder, &self.pipeline, &bind, target, clear, (&calls, 0));
+        crate::fullscreen::record_calls(encoder, &self.pipeline, bind, target, clear, (&calls, 0));
         Ok(ShadowPassReport::default())
     }
 }

@@ -11,6 +11,10 @@ pub enum Clock {
     GpuTimestamps,
     /// Wall time of submit and wait on the CPU.
     WallTime,
+    /// Wall time of one submission holding several lights, an even share each: without
+    /// timestamps inside encoders the lights recorded together cannot be told apart (their
+    /// sum is the submission's).
+    WallTimeShare,
 }
 
 impl Clock {
@@ -20,6 +24,7 @@ impl Clock {
         match self {
             Clock::GpuTimestamps => "GPU timestamps",
             Clock::WallTime => "wall time (submit + wait)",
+            Clock::WallTimeShare => "wall time (submit + wait), an even share a light",
         }
     }
 }

@@ -19,8 +19,10 @@
 //! let wedges = penumbra_wedge::Wedges::new(&gpu, &scene, penumbra_wedge::WedgeSettings::default());
 //! let light = LightShape::Distant { direction: glam::Vec3::new(0.3, 1.0, 0.2).normalize(), half_angle: 0.05 };
 //! let vis = gpu::Visibility::new(&gpu, 640, 480, 1).expect("fits");
-//! let report = wedges.write_visibility(&gpu, &Receivers::new(&gbuffer, &points), &light, &vis.layer(0));
-//! // or, in a renderer's frame: wedges.record(&gpu, &mut encoder, &receivers, &light, None, &layer)
+//! let mut encoder = gpu.encoder("frame");
+//! // a renderer records every light of its frame so, then submits once
+//! let report = wedges.record(&gpu, &mut encoder, &Receivers::new(&gbuffer, &points), &light, None, &vis.layer(0));
+//! gpu.submit(encoder);
 //! ```
 
 pub mod casters;
@@ -598,8 +600,8 @@ impl Wedges {
 
     /// The silhouette the GPU builder finds for `light` and `receivers` (with these settings'
     /// culling): its edges and their faces' normals, in the builder's order (by caster, then
-    /// along its edges' curve), without lit faces. Measurement and tests: the light measured
-    /// ([`ShadowTechnique::write_visibility`]), then its silhouette read back.
+    /// along its edges' curve), without lit faces. Measurement and tests: the light recorded
+    /// ungated and submitted, waited for, then its silhouette read back.
     ///
     /// # Errors
     /// Wedges not built on the GPU (the compute path or [`WedgeBuild::Cpu`]); casters beyond
@@ -616,7 +618,9 @@ impl Wedges {
         let mesh = self.builder.mesh.as_ref().map_err(|e| GpuError::Failed(format!("wedges: {e}")))?;
         let (w, h) = receivers.gbuffer.size();
         let vis = gpu::Visibility::new(gpu, w, h, 1)?;
-        self.write_visibility(gpu, receivers, light, &vis.layer(0))?;
+        let mut encoder = gpu.encoder("silhouette");
+        self.record(gpu, &mut encoder, receivers, light, None, &vis.layer(0))?;
+        gpu.submit_and_wait(encoder)?;
         let args: Vec<u32> = bytemuck::pod_collect_to_vec(&gpu::read_buffer(gpu, &mesh.args)?);
         let edges: Vec<[[f32; 4]; 4]> = bytemuck::pod_collect_to_vec(&gpu::read_buffer(gpu, &mesh.silhouette)?);
         let n = (args[12] as usize).min(edges.len());

@@ -3,7 +3,7 @@
 //! paper 000's scenes at 160 x 120 (lavapipe where there is no GPU).
 
 use glam::Vec3;
-use gpu::{GBufferPass, Gpu, LightShape, Receivers, SceneGeometry, ShadowTechnique, Visibility};
+use gpu::{GBufferPass, Gpu, LightShape, Receivers, SceneGeometry, Visibility};
 use ref_tracer::SceneBvh;
 use ref_tracer::visibility::{AreaLight, Weighting, area_light_visibility};
 use shadowmap_paraboloid::{MapTechnique, Pcss, ShadowSettings, Technique};
@@ -21,7 +21,7 @@ fn errors(name: &str, degrees: f32, make: impl Fn(&Gpu, &scene::Scene) -> MapTec
     let light = LightShape::Distant { direction, half_angle };
     let technique = make(&gpu, &scene);
     let vis = Visibility::new(&gpu, 160, 120, 1).unwrap();
-    technique.write_visibility(&gpu, &Receivers::new(&gb, &points), &light, &vis.layer(0)).unwrap();
+    gpu::render_visibility(&gpu, &technique, &Receivers::new(&gb, &points), &[light], &[], &vis).unwrap().remove(0);
     let v = vis.read(&gpu, 0).unwrap();
     let truth = area_light_visibility(
         &SceneBvh::new(&scene),

@@ -9,9 +9,9 @@ use crate::setting::{EnvSetting, Setting, Shadow};
 use envmap_sphere::EnvMap;
 use glam::Vec3;
 use gpu::{
-    Background, GBufferPass, Gpu, JointBilateral, LightShape, PrefilterSettings, Receivers, RotatedGrid, SceneGeometry,
-    ShadeLight, ShadeParams, ShadingPass, ShadowPassReport, ShadowTechnique, SpecularAmbient, SplitFrame, SplitPasses,
-    SplitSettings, UpsamplePass, Visibility, WEBER_FRACTION, render_split, render_visibility, weber_negligible,
+    Background, FrameLights, FrameShadows, GBufferPass, Gpu, JointBilateral, LightShape, LitFrame, LitSettings,
+    PrefilterSettings, ReceiversFrom, RotatedGrid, SceneGeometry, ShadeLight, ShadingPass, ShadowPassReport,
+    ShadowTechnique, SpecularAmbient, SplitSettings,
 };
 use light_extract::Decomposition;
 use penumbra_wedge::{WedgeSettings, Wedges};
@@ -93,7 +93,6 @@ impl Case {
 pub struct Passes {
     pub(crate) gbuffer: GBufferPass,
     pub(crate) shading: ShadingPass,
-    upsample: UpsamplePass,
 }
 
 impl Passes {
@@ -102,7 +101,7 @@ impl Passes {
     /// # Errors
     /// GPU failures.
     pub fn new(gpu: &Gpu) -> Result<Self, TradeError> {
-        Ok(Self { gbuffer: GBufferPass::new(gpu), shading: ShadingPass::new(gpu)?, upsample: UpsamplePass::new(gpu) })
+        Ok(Self { gbuffer: GBufferPass::new(gpu), shading: ShadingPass::new(gpu)? })
     }
 }
 
@@ -143,7 +142,7 @@ fn extract(cache: &mut Extractions, map: &EnvMap, method: &str, k: usize) -> Res
 
 /// What a frame needs that does not depend on the setting's shadows.
 struct FrameInput<'a> {
-    passes: &'a Passes,
+    lit: &'a LitFrame,
     geometry: &'a SceneGeometry,
     camera: &'a scene::Camera,
     decomposition: &'a Decomposition,
@@ -153,7 +152,10 @@ struct FrameInput<'a> {
     supersample: u32,
 }
 
-/// One frame: G-buffer, shadows, shading; the image left on the GPU and the shadow reports.
+/// One frame, the toolkit's recorded frame ([`gpu::LitFrame`]) waited for and its lights timed
+/// between timestamps of their own: the image left on the GPU (the frame's target, overwritten
+/// by the next) and the shadow reports. Without a technique every light is shaded unshadowed at
+/// full resolution; with one and an EnvIndirect scale above 1, paper 001's split.
 fn frame(
     gpu: &Gpu,
     input: &FrameInput,
@@ -163,55 +165,38 @@ fn frame(
     let d = input.decomposition;
     let lights: Vec<ShadeLight> = d.lights.iter().map(|l| ShadeLight::from(&l.light)).collect();
     let shapes: Vec<LightShape> = d.lights.iter().map(|l| LightShape::from(&l.light)).collect();
-    let gb = input.passes.gbuffer.render(gpu, input.geometry, input.camera)?;
-    let (w, h) = gb.size();
-    let vis = Visibility::new(gpu, w, h, lights.len().max(1) as u32)?;
-    let params = ShadeParams {
-        lights: &lights,
-        ambient: Some(&d.ambient_sh),
-        background: Some(input.background),
-        specular_ambient: input.specular,
-    };
-    let Some(technique) = technique else {
-        let image = input.passes.shading.render_texture(gpu, input.geometry, &gb, &params, &vis)?;
-        return Ok((image, Vec::new()));
-    };
-    let points = gb.read_points(gpu)?;
-    let receivers = Receivers::new(&gb, &points);
-    let negligible = if setting.weber {
-        weber_negligible(&receivers, &lights, Some(&d.ambient_sh), WEBER_FRACTION)
-    } else {
-        Vec::new()
-    };
-    let directs = if setting.indirect_scale > 1 { d.directs() } else { lights.len() };
-    let mut reports = render_visibility(gpu, technique, &receivers, &shapes[..directs], &negligible, &vis)?;
-    if directs == lights.len() {
-        let image = input.passes.shading.render_texture(gpu, input.geometry, &gb, &params, &vis)?;
-        return Ok((image, reports));
-    }
-    let split = render_split(
+    let directs = if technique.is_some() && setting.indirect_scale > 1 { d.directs() } else { lights.len() };
+    let view = GBufferPass::camera_view(input.geometry, input.camera);
+    let mut rendered = input.lit.render(
         gpu,
-        &SplitPasses {
-            gbuffer: &input.passes.gbuffer,
-            shading: &input.passes.shading,
-            upsample: &input.passes.upsample,
-        },
         input.geometry,
-        (&receivers, &vis),
-        &SplitFrame {
+        &view,
+        &FrameLights {
             lights: &lights,
             shapes: &shapes,
             directs,
             ambient: Some(&d.ambient_sh),
             specular_ambient: input.specular,
             background: Some(input.background),
-            targets: None,
         },
-        technique,
-        &SplitSettings { indirect_scale: setting.indirect_scale * input.supersample, upsample: JointBilateral::PAPER },
+        technique.map(|t| FrameShadows { direct: t, indirect: t }),
+        &LitSettings {
+            split: SplitSettings {
+                indirect_scale: setting.indirect_scale * input.supersample,
+                upsample: JointBilateral::PAPER,
+            },
+            weber: setting.weber,
+            receivers: ReceiversFrom::Gpu,
+            time_lights: true,
+        },
     )?;
-    reports.extend(split.indirect_reports);
-    Ok((split.texture, reports))
+    gpu.wait(None)?;
+    if let Some(t) = technique {
+        // what only the GPU knew (its wedges' counts), in record order, before the lights the
+        // GPU skipped are marked
+        t.read_counts(gpu, &mut rendered.reports)?;
+    }
+    Ok(rendered.finish_reports(gpu)?)
 }
 
 /// Measures every environment-lit setting of `settings` on `case` (the other families are
@@ -223,7 +208,6 @@ fn frame(
 /// An unknown method; a technique that cannot shadow distant lights; GPU failures.
 pub fn measure(
     gpu: &Gpu,
-    passes: &Passes,
     case: &Case,
     settings: &[Setting],
     plan: &Plan,
@@ -234,6 +218,8 @@ pub fn measure(
     scene.camera = *grid.camera();
     let geometry = SceneGeometry::upload(gpu, &scene)?;
     let background = Background::upload(gpu, &case.map)?;
+    // the recorded frame at the grid's size, its targets made once for every setting
+    let lit = LitFrame::new(gpu, (scene.camera.width, scene.camera.height))?;
     let glossy = scene.objects.iter().any(|o| o.material.specular.is_some());
     let (w, h) = (case.scene.camera.width, case.scene.camera.height);
     let mut cache = Extractions::new();
@@ -253,7 +239,7 @@ pub fn measure(
         let specular = specular_cache.get(&key).and_then(Option::as_ref);
         let technique = technique(gpu, &scene, &setting.shadow)?;
         let input = FrameInput {
-            passes,
+            lit: &lit,
             geometry: &geometry,
             camera: &scene.camera,
             decomposition: &d,
@@ -289,7 +275,7 @@ pub fn measure(
 }
 
 /// What an env or point frame's `ms` measures.
-pub(crate) const FRAME_CLOCK: &str = "wall time (frame: submits + waits, the G-buffer's points read back)";
+const FRAME_CLOCK: &str = "wall time (the recorded frame: its submissions and one wait)";
 
 /// `plan.repeats` frames of `frame` timed: the last frame and the median milliseconds.
 /// Pipelines compile and buffers grow on the first frame: a median of 3 or more drops it,

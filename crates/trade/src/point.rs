@@ -5,7 +5,10 @@
 
 use crate::TradeError;
 use crate::front::Measurement;
-use crate::measure::{FRAME_CLOCK, Passes, Plan, Shadows, technique, timed};
+use crate::measure::{Passes, Plan, Shadows, technique, timed};
+
+/// What a point frame's `ms` measures.
+const FRAME_CLOCK: &str = "wall time (frame: submits + waits, the G-buffer's points read back)";
 use crate::setting::Setting;
 use glam::Vec3;
 use gpu::{

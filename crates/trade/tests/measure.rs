@@ -28,11 +28,11 @@ fn maps() -> Vec<(String, EnvMap)> {
     vec![("small.exr".into(), small), ("turned.exr".into(), turned)]
 }
 
-fn run(gpu: &Gpu, passes: &Passes, shard: Shard) -> Run {
+fn run(gpu: &Gpu, shard: Shard) -> Run {
     let mut rows = Vec::new();
     for (name, map) in shard.select(&maps(), |m| m.0.clone()) {
         let case = Case::new("three_boxes", &name, map, &PLAN).expect("case");
-        rows.extend(measure(gpu, passes, &case, &settings(), &PLAN, &mut |_| {}).expect("measured"));
+        rows.extend(measure(gpu, &case, &settings(), &PLAN, &mut |_| {}).expect("measured"));
     }
     let config = RunConfig {
         size: PLAN.size,
@@ -51,8 +51,7 @@ fn run(gpu: &Gpu, passes: &Passes, shard: Shard) -> Run {
 #[test]
 fn shadows_lower_the_error_and_shards_merge_to_the_whole_run() {
     let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
-    let passes = Passes::new(&gpu).expect("passes");
-    let whole = run(&gpu, &passes, Shard::ALL);
+    let whole = run(&gpu, Shard::ALL);
     assert_eq!(whole.rows.len(), 2 * settings().len());
     for map in ["small.exr", "turned.exr"] {
         let rmse =
@@ -67,7 +66,7 @@ fn shadows_lower_the_error_and_shards_merge_to_the_whole_run() {
         assert!(whole.rows.iter().any(|r| r.map == map && r.pareto), "{map}: no front");
     }
     let shards: Vec<_> =
-        (0..2).map(|i| (format!("shard{i}").into(), run(&gpu, &passes, Shard { index: i, count: 2 }))).collect();
+        (0..2).map(|i| (format!("shard{i}").into(), run(&gpu, Shard { index: i, count: 2 }))).collect();
     let mut merged = merge(&shards).expect("merge");
     // times are measured anew in every run; everything else must agree exactly
     let times = |r: &mut Run| {

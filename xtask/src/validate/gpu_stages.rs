@@ -177,12 +177,14 @@ pub(super) fn gpu_render(
         // paper 001's frame: the EnvDirects' wedges at full resolution (the layers above),
         // the EnvIndirects' at 1/2 or 1/4 of the output's resolution, upsampled
         let frame = SplitFrame {
-            lights: &lights,
-            shapes: &shapes,
-            directs,
-            ambient: Some(&d.ambient_sh),
-            specular_ambient: specular.as_ref(),
-            background: Some(&background),
+            lit: gpu::FrameLights {
+                lights: &lights,
+                shapes: &shapes,
+                directs,
+                ambient: Some(&d.ambient_sh),
+                specular_ambient: specular.as_ref(),
+                background: Some(&background),
+            },
             targets: None,
         };
         let upsample_pass = UpsamplePass::new(gpu);

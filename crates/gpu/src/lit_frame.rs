@@ -1,0 +1,422 @@
+//! The one recorded frame: the G-buffers, their receivers reduced on the GPU, every light's
+//! shadow pass gated by that reduction, and paper 001's split shading (EnvDirects at full
+//! resolution, EnvIndirects at 1 / scale, joint-bilateral upsampled), in two submissions with no
+//! wait and no readback inside. `cargo xtask frame`, the benches and the trade draw through it;
+//! measurement wraps it ([`LitSettings::time_lights`], a wait after), it is not a second path.
+//!
+//! Everything it renders into is made once per size, scale and light count and rendered into
+//! frame after frame: a frame's image is overwritten by the next.
+
+use crate::ambient::SpecularAmbient;
+use crate::context::{Gpu, GpuError};
+use crate::gbuffer::{GBufferPass, GBufferTargets};
+use crate::geometry::SceneGeometry;
+use crate::receivers::{MappedStats, PendingStats, ReceiverReduction, WeberInput};
+use crate::shade::{Background, ShadeLight, ShadeParams, ShadingPass, Visibility};
+use crate::slots::Keyed;
+use crate::split::{SplitFrame, SplitPasses, SplitSettings, SplitTargets, record_split};
+use crate::technique::{
+    LightShape, LightStamps, Receivers, ShadowPassReport, ShadowTechnique, WEBER_FRACTION, record_visibility_stamped,
+    weber_negligible,
+};
+use crate::upsample::UpsamplePass;
+use crate::view::{View, conservative_bounds};
+use envmap_sphere::Sh9;
+use std::cell::RefCell;
+use std::rc::Rc;
+
+/// What a frame lights: its lights, the EnvDirects first, and what shades it beside them.
+#[derive(Clone, Copy)]
+pub struct FrameLights<'a> {
+    /// Every light, the EnvDirects first.
+    pub lights: &'a [ShadeLight],
+    /// Their shapes, for the shadow techniques, in the same order.
+    pub shapes: &'a [LightShape],
+    /// How many of `lights` are EnvDirects, shaded at full resolution; all of them: no split
+    /// (one shading pass at full resolution).
+    pub directs: usize,
+    /// Ambient SH9 (diffuse lobe).
+    pub ambient: Option<&'a Sh9>,
+    /// The ambient on the specular lobe.
+    pub specular_ambient: Option<&'a SpecularAmbient>,
+    /// What misses see.
+    pub background: Option<&'a Background>,
+}
+
+/// The shadow techniques of a frame: one for the EnvDirects, one for the EnvIndirects (the same
+/// one twice, or paper 001's wedges and maps).
+#[derive(Clone, Copy)]
+pub struct FrameShadows<'a> {
+    /// The EnvDirects'.
+    pub direct: &'a dyn ShadowTechnique,
+    /// The EnvIndirects'.
+    pub indirect: &'a dyn ShadowTechnique,
+}
+
+/// Where a frame's receivers come from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ReceiversFrom {
+    /// The GPU's reduction, left on the GPU: it gates each light, the CPU never waits (the
+    /// real-time frame).
+    #[default]
+    Gpu,
+    /// The same reduction mapped back first (a wait, a few hundred bytes): every light planned
+    /// on the CPU from it. A reference the real-time frame is tested against.
+    ReadStats,
+    /// The G-buffers' points mapped back (32 bytes a pixel, a wait) and reduced on the CPU
+    /// (`Receivers::new`, `weber_negligible`): the original reference.
+    CpuPoints,
+}
+
+/// How a frame is drawn.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LitSettings {
+    /// The EnvIndirects' resolution and upsampling (unused without EnvIndirects).
+    pub split: SplitSettings,
+    /// Whether Weber's law skips lights too faint to matter ([`WEBER_FRACTION`]); lights no
+    /// visible receiver faces are skipped either way.
+    pub weber: bool,
+    /// Where the receivers come from.
+    pub receivers: ReceiversFrom,
+    /// Measurement: each light's passes between two timestamps of its own, mapped with the
+    /// frame's reports ([`RenderedFrame::finish_reports`]); without timestamps inside encoders
+    /// nothing is timed. Makes a query set and two buffers a frame.
+    pub time_lights: bool,
+}
+
+impl Default for LitSettings {
+    /// Paper 001's frame: EnvIndirects at half resolution, Weber's skipping, the GPU's receivers.
+    fn default() -> Self {
+        Self { split: SplitSettings::default(), weber: true, receivers: ReceiversFrom::Gpu, time_lights: false }
+    }
+}
+
+/// A frame's image (submitted, not waited for) and what its shadow passes did.
+pub struct RenderedFrame {
+    /// The HDR image: the frame's target, which the next frame of the same size renders into.
+    pub texture: wgpu::Texture,
+    /// Per light, EnvDirects first: its shadow pass as recorded, or why it had none (empty for a
+    /// frame without shadows). Where the GPU gated the lights, which it skipped is known once
+    /// the frame has run: [`RenderedFrame::finish_reports`].
+    pub reports: Vec<ShadowPassReport>,
+    // the receivers' statistics being mapped (full resolution, then low), and the EnvDirects
+    gated: Option<(Vec<MappedStats>, usize)>,
+    // measurement: the lights' stamps being mapped
+    stamps: Option<(LightStamps, crate::readback::MappingRead)>,
+}
+
+impl RenderedFrame {
+    /// The image and the reports completed with what the GPU knew only once the frame ran:
+    /// the lights it skipped (why, and nothing drawn) and, when timed, each light's time. Read
+    /// once the frame has finished (after the caller's own wait, or a later frame's): no wait
+    /// of its own, a few hundred bytes.
+    ///
+    /// # Errors
+    /// The frame has not finished; GPU failures.
+    pub fn finish_reports(self, gpu: &Gpu) -> Result<(wgpu::Texture, Vec<ShadowPassReport>), GpuError> {
+        let mut reports = self.reports;
+        if let Some((mapped, directs)) = self.gated {
+            let stats = mapped.into_iter().map(|m| m.finish(gpu)).collect::<Result<Vec<_>, _>>()?;
+            for (k, r) in reports.iter_mut().enumerate() {
+                let s = if k < directs { stats.first() } else { stats.last() };
+                if let Some(why) = s.and_then(|s| s.skip_reason(k)) {
+                    *r = ShadowPassReport { skipped: Some(why), ..ShadowPassReport::default() };
+                }
+            }
+        }
+        if let Some((stamps, mapping)) = self.stamps {
+            let bytes = mapping.finish(gpu)?;
+            stamps.apply(gpu, bytes.first().map_or(&[][..], Vec::as_slice), &mut reports);
+        }
+        Ok((self.texture, reports))
+    }
+}
+
+/// Receivers and their Weber flags (per light of the frame; empty: none marked).
+type Flagged<'a> = (&'a Receivers<'a>, &'a [bool]);
+
+/// What a frame at one scale renders into: the low-resolution G-buffer (none at scale 1) and
+/// the split frame's images.
+type ScaleTargets = (Option<GBufferTargets>, SplitTargets);
+
+/// The frame's passes, built once, and its targets, made once per size, scale and light count.
+pub struct LitFrame {
+    gbuffer: GBufferPass,
+    shading: ShadingPass,
+    upsample: UpsamplePass,
+    // the receivers of the full- and the low-resolution G-buffer
+    reductions: [ReceiverReduction; 2],
+    targets: GBufferTargets,
+    // per (scale, EnvIndirects): the low G-buffer and the split frame's images
+    scales: RefCell<Keyed<(u32, u32), Rc<ScaleTargets>>>,
+    // the EnvDirects' visibility, per layer count
+    direct_visibility: RefCell<Keyed<u32, Rc<Visibility>>>,
+    // a frame without EnvIndirects: its one shaded image
+    whole: RefCell<Option<wgpu::Texture>>,
+}
+
+impl LitFrame {
+    /// The passes and the full-resolution targets for frames of `size` pixels.
+    ///
+    /// # Errors
+    /// Sizes beyond the adapter's limits; GPU failures.
+    pub fn new(gpu: &Gpu, size: (u32, u32)) -> Result<Self, GpuError> {
+        Ok(Self {
+            gbuffer: GBufferPass::new(gpu),
+            shading: ShadingPass::new(gpu)?,
+            upsample: UpsamplePass::new(gpu),
+            reductions: [ReceiverReduction::new(gpu), ReceiverReduction::new(gpu)],
+            targets: GBufferTargets::new(gpu, size)?,
+            scales: RefCell::default(),
+            direct_visibility: RefCell::default(),
+            whole: RefCell::new(None),
+        })
+    }
+
+    /// The frame's size.
+    #[must_use]
+    pub fn size(&self) -> (u32, u32) {
+        self.targets.size()
+    }
+
+    /// Renders `geometry` from `view` (of the frame's size) lit by `lights`, each shadowed by
+    /// `shadows` (`None`: unshadowed), and returns the image with its work submitted and not
+    /// waited for. With [`ReceiversFrom::Gpu`]: two submissions, no wait, no readback inside
+    /// (the G-buffers with their receivers reduced on the GPU, then everything else recorded
+    /// into one encoder); the reduction gates each light's draws and fits the orthographic
+    /// maps, the wedges are planned from the scene's box within the view
+    /// ([`conservative_bounds`]), and its few hundred bytes are mapped for
+    /// [`RenderedFrame::finish_reports`]. A frame without shadows is one submission.
+    ///
+    /// # Errors
+    /// A view of another size; a split frame without shadows; a scale that does not divide the
+    /// size; the techniques' errors; GPU failures.
+    pub fn render(
+        &self,
+        gpu: &Gpu,
+        geometry: &SceneGeometry,
+        view: &View,
+        lights: &FrameLights,
+        shadows: Option<FrameShadows<'_>>,
+        settings: &LitSettings,
+    ) -> Result<RenderedFrame, GpuError> {
+        if lights.directs > lights.lights.len() || lights.shapes.len() != lights.lights.len() {
+            return Err(GpuError::Failed(format!(
+                "{} directs of {} lights ({} shapes)",
+                lights.directs,
+                lights.lights.len(),
+                lights.shapes.len()
+            )));
+        }
+        let split = lights.directs < lights.lights.len();
+        if split && shadows.is_none() {
+            return Err(GpuError::Failed("a split frame needs its shadow techniques".into()));
+        }
+        let scale = settings.split.indirect_scale;
+        let low_view = view.resized(view.size().0 / scale.max(1), view.size().1 / scale.max(1));
+        let scale_targets = if split { Some(self.scale_targets(gpu, settings, lights)?) } else { None };
+        let mut encoder = gpu.encoder("frame g-buffers");
+        let gb = self.gbuffer.record_into(gpu, &mut encoder, geometry, view, &self.targets)?;
+        let low_gb = match scale_targets.as_deref() {
+            Some((Some(t), _)) => Some(self.gbuffer.record_into(gpu, &mut encoder, geometry, &low_view, t)?),
+            _ => None,
+        };
+        let Some(shadows) = shadows else {
+            let mut encoder = Some(encoder);
+            let receivers = Receivers::new(&gb, &[]);
+            return self.record_lit(gpu, &mut encoder, geometry, lights, None, (&receivers, &[]), None, settings);
+        };
+        if settings.receivers == ReceiversFrom::CpuPoints {
+            gpu.submit(encoder);
+            let points = gb.read_points(gpu)?;
+            let low_points = low_gb.as_ref().map(|l| l.read_points(gpu)).transpose()?;
+            let receivers = Receivers::new(&gb, &points);
+            let low = low_gb.as_ref().zip(low_points.as_deref()).map(|(l, p)| Receivers::new(l, p));
+            let negligible = if settings.weber {
+                weber_negligible(&receivers, lights.lights, lights.ambient, WEBER_FRACTION)
+            } else {
+                Vec::new()
+            };
+            let low_negligible = low.as_ref().map(|l| {
+                if settings.weber {
+                    weber_negligible(l, lights.lights, lights.ambient, WEBER_FRACTION)
+                } else {
+                    Vec::new()
+                }
+            });
+            let low = low.as_ref().map(|l| (l, low_negligible.as_deref().unwrap_or(&[])));
+            let mut encoder = None;
+            let receivers = (&receivers, negligible.as_slice());
+            return self.record_lit(gpu, &mut encoder, geometry, lights, Some(shadows), receivers, low, settings);
+        }
+        let weber = settings.weber.then_some(WeberInput {
+            lights: lights.lights,
+            ambient: lights.ambient,
+            fraction: WEBER_FRACTION,
+        });
+        let mut pending = vec![self.reductions[0].record(gpu, &mut encoder, &gb, lights.shapes, weber)?];
+        if let Some(l) = &low_gb {
+            pending.push(self.reductions[1].record(gpu, &mut encoder, l, lights.shapes, weber)?);
+        }
+        gpu.submit(encoder);
+        if settings.receivers == ReceiversFrom::ReadStats {
+            let stats = PendingStats::read_all(gpu, pending)?;
+            let receivers = Receivers::from_stats(&gb, &stats[0], lights.shapes);
+            let low = low_gb.as_ref().map(|l| Receivers::from_stats(l, &stats[1], lights.shapes));
+            let (negligible, low_negligible) = (&stats[0].negligible, &stats[stats.len() - 1].negligible);
+            let low = low.as_ref().map(|l| (l, low_negligible.as_slice()));
+            let mut encoder = None;
+            let receivers = (&receivers, negligible.as_slice());
+            return self.record_lit(gpu, &mut encoder, geometry, lights, Some(shadows), receivers, low, settings);
+        }
+        let scene_box = {
+            let (lo, hi) = geometry.bounds;
+            (lo.is_finite() && hi.is_finite()).then_some((lo, hi))
+        };
+        let directs = lights.directs as u32;
+        let receivers = Receivers::on_gpu(
+            &gb,
+            scene_box.and_then(|b| conservative_bounds(b, &gb.view)),
+            pending[0].on_gpu().clone(),
+        );
+        let low_gpu = pending[pending.len() - 1].on_gpu().starting_at(directs);
+        let low_receivers = match &low_gb {
+            Some(l) => Receivers::on_gpu(l, scene_box.and_then(|b| conservative_bounds(b, &l.view)), low_gpu),
+            None => Receivers::on_gpu(&gb, receivers.bounds, low_gpu),
+        };
+        let mut encoder = None;
+        let frame = self.record_lit(
+            gpu,
+            &mut encoder,
+            geometry,
+            lights,
+            Some(shadows),
+            (&receivers, &[]),
+            Some((&low_receivers, &[])),
+            settings,
+        )?;
+        let mapped = pending.into_iter().map(|p| p.map(gpu)).collect();
+        Ok(RenderedFrame { gated: Some((mapped, lights.directs)), ..frame })
+    }
+
+    /// The low-resolution G-buffer's (none at scale 1) and the split frame's targets.
+    fn scale_targets(
+        &self,
+        gpu: &Gpu,
+        settings: &LitSettings,
+        lights: &FrameLights,
+    ) -> Result<Rc<ScaleTargets>, GpuError> {
+        let scale = settings.split.indirect_scale;
+        let indirects = (lights.lights.len() - lights.directs) as u32;
+        let size = self.size();
+        let make = || {
+            if scale == 0 || !size.0.is_multiple_of(scale) || !size.1.is_multiple_of(scale) {
+                return Err(GpuError::Failed(format!(
+                    "EnvIndirects at 1/{scale} of {}x{}: the scale must divide both sides",
+                    size.0, size.1
+                )));
+            }
+            // at scale 1 the EnvIndirects are shaded from the full-resolution G-buffer
+            let low = (scale != 1).then(|| GBufferTargets::new(gpu, (size.0 / scale, size.1 / scale))).transpose()?;
+            Ok(Rc::new((low, SplitTargets::new(gpu, size, &settings.split, indirects)?)))
+        };
+        Ok(self.scales.borrow_mut().try_get((scale, indirects), make)?.clone())
+    }
+
+    /// Records the lights' shadows and the shading over `receivers` and `low` (each with its
+    /// Weber flags, per light of the frame; `low` `None`: the full-resolution ones) into
+    /// `encoder` (a new one when `None`), submits it and returns the frame.
+    #[allow(clippy::too_many_arguments)]
+    fn record_lit(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut Option<wgpu::CommandEncoder>,
+        geometry: &SceneGeometry,
+        lights: &FrameLights,
+        shadows: Option<FrameShadows<'_>>,
+        (receivers, negligible): Flagged<'_>,
+        low: Option<Flagged<'_>>,
+        settings: &LitSettings,
+    ) -> Result<RenderedFrame, GpuError> {
+        let mut encoder = encoder.take().unwrap_or_else(|| gpu.encoder("frame"));
+        let directs = lights.directs;
+        let vis = {
+            let layers = (directs as u32).max(1);
+            let mut cache = self.direct_visibility.borrow_mut();
+            cache
+                .try_get(layers, || Visibility::allocate(gpu, self.size().0, self.size().1, layers).map(Rc::new))?
+                .clone()
+        };
+        vis.record_clear(&mut encoder);
+        let stamps =
+            if settings.time_lights && shadows.is_some() { LightStamps::new(gpu, lights.lights.len())? } else { None };
+        let mut reports = match shadows {
+            Some(s) => record_visibility_stamped(
+                gpu,
+                &mut encoder,
+                (s.direct, receivers),
+                (&lights.shapes[..directs], negligible.get(..directs).unwrap_or(&[])),
+                &vis,
+                stamps.as_ref(),
+            )?,
+            None => Vec::new(),
+        };
+        let texture = if directs == lights.lights.len() {
+            let target = {
+                let mut whole = self.whole.borrow_mut();
+                let size = self.size();
+                if whole.as_ref().is_none_or(|t| (t.width(), t.height()) != size) {
+                    *whole = Some(crate::target::render_target(
+                        gpu,
+                        "lit frame",
+                        (size.0, size.1, 1),
+                        crate::shade::HDR_FORMAT,
+                    )?);
+                }
+                whole.clone().ok_or_else(|| GpuError::Failed("lit frame target".into()))?
+            };
+            self.shading.record_into(
+                gpu,
+                &mut encoder,
+                geometry,
+                receivers.gbuffer,
+                &ShadeParams {
+                    lights: lights.lights,
+                    ambient: lights.ambient,
+                    background: lights.background,
+                    specular_ambient: lights.specular_ambient,
+                },
+                &vis,
+                &target,
+            )?;
+            target
+        } else {
+            let shadows =
+                shadows.ok_or_else(|| GpuError::Failed("a split frame needs its shadow techniques".into()))?;
+            let targets = self.scale_targets(gpu, settings, lights)?;
+            let (low, low_negligible) = low.unwrap_or((receivers, negligible));
+            let split = record_split(
+                gpu,
+                &mut encoder,
+                &SplitPasses { gbuffer: &self.gbuffer, shading: &self.shading, upsample: &self.upsample },
+                geometry,
+                (receivers, &vis),
+                (low, Some(low_negligible)),
+                &SplitFrame { lit: *lights, targets: Some(&targets.1) },
+                shadows.indirect,
+                &settings.split,
+            )?;
+            reports.extend(split.indirect_reports);
+            split.texture
+        };
+        if let Some(s) = &stamps {
+            s.record_resolve(&mut encoder);
+        }
+        gpu.submit(encoder);
+        let stamps = stamps.map(|s| {
+            let mapping = crate::readback::MappingRead::start(gpu, vec![s.read_buffer().clone()]);
+            (s, mapping)
+        });
+        Ok(RenderedFrame { texture, reports, gated: None, stamps })
+    }
+}
