@@ -7,7 +7,7 @@
 use envmap_sphere::EnvMap;
 use gpu::{
     Background, FrameLights, FrameShadows, GBufferPass, Gpu, GpuError, JointBilateral, LightShape, LitFrame,
-    LitSettings, PrefilterSettings, ReceiversFrom, SceneGeometry, ShadeLight, SpecularAmbient, SplitSettings,
+    LitSettings, PrefilterSettings, ReferenceReceivers, SceneGeometry, ShadeLight, SpecularAmbient, SplitSettings,
 };
 use light_extract::Decomposition;
 use penumbra_wedge::{WedgeSettings, Wedges};
@@ -133,55 +133,55 @@ impl Frame {
     /// # Errors
     /// GPU failures; a scale that does not divide the size.
     pub fn render(&self, gpu: &Gpu, scale: u32) -> Result<RenderedFrame, GpuError> {
-        self.render_with(gpu, scale, ReceiversFrom::Gpu)
+        self.render_with(gpu, scale, None)
     }
 
     /// The same frame with the CPU waiting for the GPU's reduction (a few hundred bytes) and
-    /// planning every light from it ([`ReceiversFrom::ReadStats`]): a reference for
+    /// planning every light from it ([`ReferenceReceivers::ReadStats`]): a reference for
     /// [`Frame::render`].
     ///
     /// # Errors
     /// As [`Frame::render`].
     pub fn render_from_read_stats(&self, gpu: &Gpu, scale: u32) -> Result<RenderedFrame, GpuError> {
-        self.render_with(gpu, scale, ReceiversFrom::ReadStats)
+        self.render_with(gpu, scale, Some(ReferenceReceivers::ReadStats))
     }
 
     /// The same frame with its receivers made on the CPU from the G-buffers' points mapped back
-    /// ([`ReceiversFrom::CpuPoints`]), waited for: the reference the GPU reduction of
+    /// ([`ReferenceReceivers::CpuPoints`]), waited for: the reference the GPU reduction of
     /// [`Frame::render`] is tested against, not a real-time path.
     ///
     /// # Errors
     /// As [`Frame::render`].
     pub fn render_from_cpu_receivers(&self, gpu: &Gpu, scale: u32) -> Result<wgpu::Texture, GpuError> {
-        let frame = self.render_with(gpu, scale, ReceiversFrom::CpuPoints)?;
+        let frame = self.render_with(gpu, scale, Some(ReferenceReceivers::CpuPoints))?;
         gpu.wait(None)?;
         Ok(frame.texture)
     }
 
-    fn render_with(&self, gpu: &Gpu, scale: u32, receivers: ReceiversFrom) -> Result<RenderedFrame, GpuError> {
+    fn render_with(&self, gpu: &Gpu, scale: u32, from: Option<ReferenceReceivers>) -> Result<RenderedFrame, GpuError> {
         let d = &self.decomposition;
         let lights: Vec<ShadeLight> = d.lights.iter().map(|l| ShadeLight::from(&l.light)).collect();
         let shapes: Vec<LightShape> = d.lights.iter().map(|l| LightShape::from(&l.light)).collect();
         let view = GBufferPass::camera_view(&self.geometry, &self.scene.camera);
-        self.lit.render(
-            gpu,
-            &self.geometry,
-            &view,
-            &FrameLights {
-                lights: &lights,
-                shapes: &shapes,
-                directs: d.directs(),
-                ambient: Some(&d.ambient_sh),
-                specular_ambient: Some(&self.specular),
-                background: Some(&self.background),
-            },
-            Some(FrameShadows { direct: &self.wedges, indirect: &self.maps }),
-            &LitSettings {
-                split: SplitSettings { indirect_scale: scale, upsample: JointBilateral::PAPER },
-                receivers,
-                ..LitSettings::default()
-            },
-        )
+        let frame_lights = FrameLights {
+            lights: &lights,
+            shapes: &shapes,
+            directs: d.directs(),
+            ambient: Some(&d.ambient_sh),
+            specular_ambient: Some(&self.specular),
+            background: Some(&self.background),
+        };
+        let shadows = FrameShadows { direct: &self.wedges, indirect: &self.maps };
+        let settings = LitSettings {
+            split: SplitSettings { indirect_scale: scale, upsample: JointBilateral::PAPER },
+            ..LitSettings::default()
+        };
+        match from {
+            None => self.lit.render(gpu, &self.geometry, &view, &frame_lights, Some(shadows), &settings),
+            Some(from) => {
+                self.lit.render_reference(gpu, &self.geometry, &view, &frame_lights, shadows, &settings, from)
+            }
+        }
     }
 
     /// [`Frame::render`] waited for: the wall time of the whole frame (CPU work included) and

@@ -45,7 +45,7 @@ pub use gbuffer::{
 };
 pub use geometry::{Chunk, SceneGeometry, ShadowGeometry, scene_triangles};
 pub use interleave::{InterleavePass, InterleavedFrame, MAX_SETS, interleave_set, interleave_tile, render_interleaved};
-pub use lit_frame::{FrameLights, FrameShadows, LitFrame, LitSettings, ReceiversFrom, RenderedFrame};
+pub use lit_frame::{FrameLights, FrameShadows, LitFrame, LitSettings, ReferenceReceivers, RenderedFrame};
 pub use readback::{
     MappingRead, PendingRead, read_buffer, read_mapped, read_mapped_all, read_texture_f32, read_texture_rgba,
 };

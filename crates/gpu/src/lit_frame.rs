@@ -9,12 +9,12 @@
 
 use crate::ambient::SpecularAmbient;
 use crate::context::{Gpu, GpuError};
-use crate::gbuffer::{GBufferPass, GBufferTargets};
+use crate::gbuffer::{GBuffer, GBufferPass, GBufferTargets};
 use crate::geometry::SceneGeometry;
 use crate::receivers::{MappedStats, PendingStats, ReceiverReduction, WeberInput};
 use crate::shade::{Background, ShadeLight, ShadeParams, ShadingPass, Visibility};
 use crate::slots::Keyed;
-use crate::split::{SplitFrame, SplitPasses, SplitSettings, SplitTargets, record_split};
+use crate::split::{SplitFrame, SplitPasses, SplitSettings, SplitTargets, indirect_size, record_split};
 use crate::technique::{
     LightShape, LightStamps, Receivers, ShadowPassReport, ShadowTechnique, WEBER_FRACTION, record_visibility_stamped,
     weber_negligible,
@@ -53,17 +53,13 @@ pub struct FrameShadows<'a> {
     pub indirect: &'a dyn ShadowTechnique,
 }
 
-/// Where a frame's receivers come from.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum ReceiversFrom {
-    /// The GPU's reduction, left on the GPU: it gates each light, the CPU never waits (the
-    /// real-time frame).
-    #[default]
-    Gpu,
-    /// The same reduction mapped back first (a wait, a few hundred bytes): every light planned
-    /// on the CPU from it. A reference the real-time frame is tested against.
+/// Where a reference frame's receivers come from ([`LitFrame::render_reference`]): the CPU
+/// waits for them and plans every light from them, as no real-time frame does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ReferenceReceivers {
+    /// The GPU's reduction mapped back (a few hundred bytes).
     ReadStats,
-    /// The G-buffers' points mapped back (32 bytes a pixel, a wait) and reduced on the CPU
+    /// The G-buffers' points mapped back (32 bytes a pixel) and reduced on the CPU
     /// (`Receivers::new`, `weber_negligible`): the original reference.
     CpuPoints,
 }
@@ -76,8 +72,6 @@ pub struct LitSettings {
     /// Whether Weber's law skips lights too faint to matter ([`WEBER_FRACTION`]); lights no
     /// visible receiver faces are skipped either way.
     pub weber: bool,
-    /// Where the receivers come from.
-    pub receivers: ReceiversFrom,
     /// Measurement: each light's passes between two timestamps of its own, mapped with the
     /// frame's reports ([`RenderedFrame::finish_reports`]); without timestamps inside encoders
     /// nothing is timed. Makes a query set and two buffers a frame.
@@ -85,9 +79,9 @@ pub struct LitSettings {
 }
 
 impl Default for LitSettings {
-    /// Paper 001's frame: EnvIndirects at half resolution, Weber's skipping, the GPU's receivers.
+    /// Paper 001's frame: EnvIndirects at half resolution, Weber's skipping.
     fn default() -> Self {
-        Self { split: SplitSettings::default(), weber: true, receivers: ReceiversFrom::Gpu, time_lights: false }
+        Self { split: SplitSettings::default(), weber: true, time_lights: false }
     }
 }
 
@@ -152,7 +146,7 @@ pub struct LitFrame {
     // the EnvDirects' visibility, per layer count
     direct_visibility: RefCell<Keyed<u32, Rc<Visibility>>>,
     // a frame without EnvIndirects: its one shaded image
-    whole: RefCell<Option<wgpu::Texture>>,
+    whole: RefCell<Keyed<(u32, u32), wgpu::Texture>>,
 }
 
 impl LitFrame {
@@ -169,7 +163,7 @@ impl LitFrame {
             targets: GBufferTargets::new(gpu, size)?,
             scales: RefCell::default(),
             direct_visibility: RefCell::default(),
-            whole: RefCell::new(None),
+            whole: RefCell::default(),
         })
     }
 
@@ -181,12 +175,12 @@ impl LitFrame {
 
     /// Renders `geometry` from `view` (of the frame's size) lit by `lights`, each shadowed by
     /// `shadows` (`None`: unshadowed), and returns the image with its work submitted and not
-    /// waited for. With [`ReceiversFrom::Gpu`]: two submissions, no wait, no readback inside
-    /// (the G-buffers with their receivers reduced on the GPU, then everything else recorded
-    /// into one encoder); the reduction gates each light's draws and fits the orthographic
-    /// maps, the wedges are planned from the scene's box within the view
-    /// ([`conservative_bounds`]), and its few hundred bytes are mapped for
-    /// [`RenderedFrame::finish_reports`]. A frame without shadows is one submission.
+    /// waited for: two submissions, no wait, no readback inside (the G-buffers with their
+    /// receivers reduced on the GPU, then everything else recorded into one encoder). The
+    /// reduction gates each light's draws and fits the orthographic maps, the wedges are planned
+    /// from the scene's box within the view ([`conservative_bounds`]), and its few hundred bytes
+    /// are mapped for [`RenderedFrame::finish_reports`]. A frame without shadows is one
+    /// submission.
     ///
     /// # Errors
     /// A view of another size; a split frame without shadows; a scale that does not divide the
@@ -200,94 +194,30 @@ impl LitFrame {
         shadows: Option<FrameShadows<'_>>,
         settings: &LitSettings,
     ) -> Result<RenderedFrame, GpuError> {
-        if lights.directs > lights.lights.len() || lights.shapes.len() != lights.lights.len() {
-            return Err(GpuError::Failed(format!(
-                "{} directs of {} lights ({} shapes)",
-                lights.directs,
-                lights.lights.len(),
-                lights.shapes.len()
-            )));
-        }
-        let split = lights.directs < lights.lights.len();
-        if split && shadows.is_none() {
-            return Err(GpuError::Failed("a split frame needs its shadow techniques".into()));
-        }
-        let scale = settings.split.indirect_scale;
-        let low_view = view.resized(view.size().0 / scale.max(1), view.size().1 / scale.max(1));
-        let scale_targets = if split { Some(self.scale_targets(gpu, settings, lights)?) } else { None };
+        self.check(lights, shadows.is_some(), settings)?;
         let mut encoder = gpu.encoder("frame g-buffers");
-        let gb = self.gbuffer.record_into(gpu, &mut encoder, geometry, view, &self.targets)?;
-        let low_gb = match scale_targets.as_deref() {
-            Some((Some(t), _)) => Some(self.gbuffer.record_into(gpu, &mut encoder, geometry, &low_view, t)?),
-            _ => None,
-        };
+        let (gb, low_gb) = self.record_gbuffers(gpu, &mut encoder, geometry, view, lights, settings)?;
         let Some(shadows) = shadows else {
-            let mut encoder = Some(encoder);
             let receivers = Receivers::new(&gb, &[]);
-            return self.record_lit(gpu, &mut encoder, geometry, lights, None, (&receivers, &[]), None, settings);
+            return self.record_lit(gpu, encoder, geometry, lights, None, (&receivers, &[]), None, settings);
         };
-        if settings.receivers == ReceiversFrom::CpuPoints {
-            gpu.submit(encoder);
-            let points = gb.read_points(gpu)?;
-            let low_points = low_gb.as_ref().map(|l| l.read_points(gpu)).transpose()?;
-            let receivers = Receivers::new(&gb, &points);
-            let low = low_gb.as_ref().zip(low_points.as_deref()).map(|(l, p)| Receivers::new(l, p));
-            let negligible = if settings.weber {
-                weber_negligible(&receivers, lights.lights, lights.ambient, WEBER_FRACTION)
-            } else {
-                Vec::new()
-            };
-            let low_negligible = low.as_ref().map(|l| {
-                if settings.weber {
-                    weber_negligible(l, lights.lights, lights.ambient, WEBER_FRACTION)
-                } else {
-                    Vec::new()
-                }
-            });
-            let low = low.as_ref().map(|l| (l, low_negligible.as_deref().unwrap_or(&[])));
-            let mut encoder = None;
-            let receivers = (&receivers, negligible.as_slice());
-            return self.record_lit(gpu, &mut encoder, geometry, lights, Some(shadows), receivers, low, settings);
-        }
-        let weber = settings.weber.then_some(WeberInput {
-            lights: lights.lights,
-            ambient: lights.ambient,
-            fraction: WEBER_FRACTION,
-        });
-        let mut pending = vec![self.reductions[0].record(gpu, &mut encoder, &gb, lights.shapes, weber)?];
-        if let Some(l) = &low_gb {
-            pending.push(self.reductions[1].record(gpu, &mut encoder, l, lights.shapes, weber)?);
-        }
+        let pending = self.record_reductions(gpu, &mut encoder, (&gb, low_gb.as_ref()), lights, settings)?;
         gpu.submit(encoder);
-        if settings.receivers == ReceiversFrom::ReadStats {
-            let stats = PendingStats::read_all(gpu, pending)?;
-            let receivers = Receivers::from_stats(&gb, &stats[0], lights.shapes);
-            let low = low_gb.as_ref().map(|l| Receivers::from_stats(l, &stats[1], lights.shapes));
-            let (negligible, low_negligible) = (&stats[0].negligible, &stats[stats.len() - 1].negligible);
-            let low = low.as_ref().map(|l| (l, low_negligible.as_slice()));
-            let mut encoder = None;
-            let receivers = (&receivers, negligible.as_slice());
-            return self.record_lit(gpu, &mut encoder, geometry, lights, Some(shadows), receivers, low, settings);
-        }
         let scene_box = {
             let (lo, hi) = geometry.bounds;
             (lo.is_finite() && hi.is_finite()).then_some((lo, hi))
         };
-        let directs = lights.directs as u32;
-        let receivers = Receivers::on_gpu(
-            &gb,
-            scene_box.and_then(|b| conservative_bounds(b, &gb.view)),
-            pending[0].on_gpu().clone(),
-        );
-        let low_gpu = pending[pending.len() - 1].on_gpu().starting_at(directs);
+        let in_view = |g: &GBuffer| scene_box.and_then(|b| conservative_bounds(b, &g.view));
+        let receivers = Receivers::on_gpu(&gb, in_view(&gb), pending[0].on_gpu().clone());
+        // the EnvIndirects' gates are the low reduction's, from their first light on
+        let low_gpu = pending[pending.len() - 1].on_gpu().starting_at(lights.directs as u32);
         let low_receivers = match &low_gb {
-            Some(l) => Receivers::on_gpu(l, scene_box.and_then(|b| conservative_bounds(b, &l.view)), low_gpu),
+            Some(l) => Receivers::on_gpu(l, in_view(l), low_gpu),
             None => Receivers::on_gpu(&gb, receivers.bounds, low_gpu),
         };
-        let mut encoder = None;
         let frame = self.record_lit(
             gpu,
-            &mut encoder,
+            gpu.encoder("frame"),
             geometry,
             lights,
             Some(shadows),
@@ -297,6 +227,124 @@ impl LitFrame {
         )?;
         let mapped = pending.into_iter().map(|p| p.map(gpu)).collect();
         Ok(RenderedFrame { gated: Some((mapped, lights.directs)), ..frame })
+    }
+
+    /// The same frame with the CPU waiting for its receivers (`from`) and planning every light
+    /// from them: the references [`LitFrame::render`] is tested against. A measuring wrapper,
+    /// not a real-time path: it waits for the G-buffers (and the reduction) before recording
+    /// the shadows; the rest is submitted and not waited for.
+    ///
+    /// # Errors
+    /// As [`LitFrame::render`].
+    #[allow(clippy::too_many_arguments)]
+    pub fn render_reference(
+        &self,
+        gpu: &Gpu,
+        geometry: &SceneGeometry,
+        view: &View,
+        lights: &FrameLights,
+        shadows: FrameShadows<'_>,
+        settings: &LitSettings,
+        from: ReferenceReceivers,
+    ) -> Result<RenderedFrame, GpuError> {
+        self.check(lights, true, settings)?;
+        let mut encoder = gpu.encoder("reference g-buffers");
+        let (gb, low_gb) = self.record_gbuffers(gpu, &mut encoder, geometry, view, lights, settings)?;
+        let points;
+        let stats;
+        // the receivers with their Weber flags, full resolution and low
+        let (receivers, low) = match from {
+            ReferenceReceivers::CpuPoints => {
+                gpu.submit(encoder);
+                points = (gb.read_points(gpu)?, low_gb.as_ref().map(|l| l.read_points(gpu)).transpose()?);
+                let weber = |r: &Receivers| {
+                    if settings.weber {
+                        weber_negligible(r, lights.lights, lights.ambient, WEBER_FRACTION)
+                    } else {
+                        Vec::new()
+                    }
+                };
+                let full = Receivers::new(&gb, &points.0);
+                let low = low_gb.as_ref().zip(points.1.as_deref()).map(|(l, p)| Receivers::new(l, p));
+                let (full_flags, low_flags) = (weber(&full), low.as_ref().map(weber));
+                ((full, full_flags), low.zip(low_flags))
+            }
+            ReferenceReceivers::ReadStats => {
+                let pending = self.record_reductions(gpu, &mut encoder, (&gb, low_gb.as_ref()), lights, settings)?;
+                gpu.submit(encoder);
+                stats = PendingStats::read_all(gpu, pending)?;
+                let last = &stats[stats.len() - 1];
+                let low =
+                    low_gb.as_ref().map(|l| (Receivers::from_stats(l, last, lights.shapes), last.negligible.clone()));
+                ((Receivers::from_stats(&gb, &stats[0], lights.shapes), stats[0].negligible.clone()), low)
+            }
+        };
+        let low = low.as_ref().map(|(r, n)| (r, n.as_slice()));
+        let receivers = (&receivers.0, receivers.1.as_slice());
+        self.record_lit(gpu, gpu.encoder("reference frame"), geometry, lights, Some(shadows), receivers, low, settings)
+    }
+
+    /// What a frame asks of its lights and settings, checked before anything is recorded.
+    fn check(&self, lights: &FrameLights, shadowed: bool, settings: &LitSettings) -> Result<(), GpuError> {
+        if lights.directs > lights.lights.len() || lights.shapes.len() != lights.lights.len() {
+            return Err(GpuError::Failed(format!(
+                "{} directs of {} lights ({} shapes)",
+                lights.directs,
+                lights.lights.len(),
+                lights.shapes.len()
+            )));
+        }
+        if lights.directs < lights.lights.len() {
+            if !shadowed {
+                return Err(GpuError::Failed("a split frame needs its shadow techniques".into()));
+            }
+            indirect_size(self.size(), &settings.split)?;
+        }
+        Ok(())
+    }
+
+    /// Records the full-resolution G-buffer and, for a split frame below full resolution, the
+    /// EnvIndirects' into `encoder`.
+    fn record_gbuffers(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        geometry: &SceneGeometry,
+        view: &View,
+        lights: &FrameLights,
+        settings: &LitSettings,
+    ) -> Result<(GBuffer, Option<GBuffer>), GpuError> {
+        let gb = self.gbuffer.record_into(gpu, encoder, geometry, view, &self.targets)?;
+        let low = if lights.directs < lights.lights.len() {
+            match (&self.scale_targets(gpu, settings, lights)?.0, indirect_size(view.size(), &settings.split)?) {
+                (Some(t), (w, h)) => Some(self.gbuffer.record_into(gpu, encoder, geometry, &view.resized(w, h), t)?),
+                (None, _) => None,
+            }
+        } else {
+            None
+        };
+        Ok((gb, low))
+    }
+
+    /// Records the reduction of the full-resolution receivers and of the low ones, if any.
+    fn record_reductions(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        (gb, low_gb): (&GBuffer, Option<&GBuffer>),
+        lights: &FrameLights,
+        settings: &LitSettings,
+    ) -> Result<Vec<PendingStats>, GpuError> {
+        let weber = settings.weber.then_some(WeberInput {
+            lights: lights.lights,
+            ambient: lights.ambient,
+            fraction: WEBER_FRACTION,
+        });
+        let mut pending = vec![self.reductions[0].record(gpu, encoder, gb, lights.shapes, weber)?];
+        if let Some(l) = low_gb {
+            pending.push(self.reductions[1].record(gpu, encoder, l, lights.shapes, weber)?);
+        }
+        Ok(pending)
     }
 
     /// The low-resolution G-buffer's (none at scale 1) and the split frame's targets.
@@ -310,14 +358,9 @@ impl LitFrame {
         let indirects = (lights.lights.len() - lights.directs) as u32;
         let size = self.size();
         let make = || {
-            if scale == 0 || !size.0.is_multiple_of(scale) || !size.1.is_multiple_of(scale) {
-                return Err(GpuError::Failed(format!(
-                    "EnvIndirects at 1/{scale} of {}x{}: the scale must divide both sides",
-                    size.0, size.1
-                )));
-            }
+            let low_size = indirect_size(size, &settings.split)?;
             // at scale 1 the EnvIndirects are shaded from the full-resolution G-buffer
-            let low = (scale != 1).then(|| GBufferTargets::new(gpu, (size.0 / scale, size.1 / scale))).transpose()?;
+            let low = (scale != 1).then(|| GBufferTargets::new(gpu, low_size)).transpose()?;
             Ok(Rc::new((low, SplitTargets::new(gpu, size, &settings.split, indirects)?)))
         };
         Ok(self.scales.borrow_mut().try_get((scale, indirects), make)?.clone())
@@ -325,12 +368,13 @@ impl LitFrame {
 
     /// Records the lights' shadows and the shading over `receivers` and `low` (each with its
     /// Weber flags, per light of the frame; `low` `None`: the full-resolution ones) into
-    /// `encoder` (a new one when `None`), submits it and returns the frame.
+    /// `encoder`, submits it and returns the frame. A split frame has its `shadows`
+    /// ([`LitFrame::check`]).
     #[allow(clippy::too_many_arguments)]
     fn record_lit(
         &self,
         gpu: &Gpu,
-        encoder: &mut Option<wgpu::CommandEncoder>,
+        mut encoder: wgpu::CommandEncoder,
         geometry: &SceneGeometry,
         lights: &FrameLights,
         shadows: Option<FrameShadows<'_>>,
@@ -338,14 +382,12 @@ impl LitFrame {
         low: Option<Flagged<'_>>,
         settings: &LitSettings,
     ) -> Result<RenderedFrame, GpuError> {
-        let mut encoder = encoder.take().unwrap_or_else(|| gpu.encoder("frame"));
         let directs = lights.directs;
+        let size = self.size();
         let vis = {
             let layers = (directs as u32).max(1);
             let mut cache = self.direct_visibility.borrow_mut();
-            cache
-                .try_get(layers, || Visibility::allocate(gpu, self.size().0, self.size().1, layers).map(Rc::new))?
-                .clone()
+            cache.try_get(layers, || Visibility::allocate(gpu, size.0, size.1, layers).map(Rc::new))?.clone()
         };
         vis.record_clear(&mut encoder);
         let stamps =
@@ -361,53 +403,41 @@ impl LitFrame {
             )?,
             None => Vec::new(),
         };
-        let texture = if directs == lights.lights.len() {
-            let target = {
-                let mut whole = self.whole.borrow_mut();
-                let size = self.size();
-                if whole.as_ref().is_none_or(|t| (t.width(), t.height()) != size) {
-                    *whole = Some(crate::target::render_target(
-                        gpu,
-                        "lit frame",
-                        (size.0, size.1, 1),
-                        crate::shade::HDR_FORMAT,
-                    )?);
-                }
-                whole.clone().ok_or_else(|| GpuError::Failed("lit frame target".into()))?
-            };
-            self.shading.record_into(
-                gpu,
-                &mut encoder,
-                geometry,
-                receivers.gbuffer,
-                &ShadeParams {
+        let texture = match shadows {
+            Some(shadows) if directs < lights.lights.len() => {
+                let targets = self.scale_targets(gpu, settings, lights)?;
+                let (low, low_negligible) = low.unwrap_or((receivers, negligible));
+                let split = record_split(
+                    gpu,
+                    &mut encoder,
+                    &SplitPasses { gbuffer: &self.gbuffer, shading: &self.shading, upsample: &self.upsample },
+                    geometry,
+                    (receivers, &vis),
+                    (low, Some(low_negligible)),
+                    &SplitFrame { lit: *lights, targets: Some(&targets.1) },
+                    shadows.indirect,
+                    &settings.split,
+                )?;
+                reports.extend(split.indirect_reports);
+                split.texture
+            }
+            _ => {
+                let target = self
+                    .whole
+                    .borrow_mut()
+                    .try_get(size, || {
+                        crate::target::render_target(gpu, "lit frame", (size.0, size.1, 1), crate::shade::HDR_FORMAT)
+                    })?
+                    .clone();
+                let params = ShadeParams {
                     lights: lights.lights,
                     ambient: lights.ambient,
                     background: lights.background,
                     specular_ambient: lights.specular_ambient,
-                },
-                &vis,
-                &target,
-            )?;
-            target
-        } else {
-            let shadows =
-                shadows.ok_or_else(|| GpuError::Failed("a split frame needs its shadow techniques".into()))?;
-            let targets = self.scale_targets(gpu, settings, lights)?;
-            let (low, low_negligible) = low.unwrap_or((receivers, negligible));
-            let split = record_split(
-                gpu,
-                &mut encoder,
-                &SplitPasses { gbuffer: &self.gbuffer, shading: &self.shading, upsample: &self.upsample },
-                geometry,
-                (receivers, &vis),
-                (low, Some(low_negligible)),
-                &SplitFrame { lit: *lights, targets: Some(&targets.1) },
-                shadows.indirect,
-                &settings.split,
-            )?;
-            reports.extend(split.indirect_reports);
-            split.texture
+                };
+                self.shading.record_into(gpu, &mut encoder, geometry, receivers.gbuffer, &params, &vis, &target)?;
+                target
+            }
         };
         if let Some(s) = &stamps {
             s.record_resolve(&mut encoder);

@@ -109,7 +109,7 @@ pub fn indirect_camera(camera: &scene::Camera, settings: &SplitSettings) -> Resu
 }
 
 /// The size the EnvIndirects are shaded at for a frame of `(w, h)` pixels.
-fn indirect_size((w, h): (u32, u32), settings: &SplitSettings) -> Result<(u32, u32), GpuError> {
+pub(crate) fn indirect_size((w, h): (u32, u32), settings: &SplitSettings) -> Result<(u32, u32), GpuError> {
     let f = settings.indirect_scale;
     if f == 0 || !w.is_multiple_of(f) || !h.is_multiple_of(f) {
         return Err(GpuError::Failed(format!("EnvIndirects at 1/{f} of {w}x{h}: the scale must divide both sides")));

@@ -6,7 +6,7 @@
 use glam::Vec3;
 use gpu::{
     FrameLights, FrameShadows, GBufferPass, Gpu, LightShape, LitFrame, LitSettings, PrecomputedVisibility, Receivers,
-    ReceiversFrom, SceneGeometry, ShadeLight, ShadeParams, ShadingPass, Visibility, read_hdr,
+    ReferenceReceivers, SceneGeometry, ShadeLight, ShadeParams, ShadingPass, Visibility, read_hdr,
 };
 
 /// The ground alone: nothing visible faces a light from below.
@@ -103,10 +103,9 @@ fn the_recorded_frame_equals_its_passes_put_together() {
         assert_eq!(read_hdr(&gpu, &texture).unwrap(), shadowed, "frame {k}");
     }
     // the references agree with it
-    for from in [ReceiversFrom::ReadStats, ReceiversFrom::CpuPoints] {
-        let frame = lit
-            .render(&gpu, &geometry, &view, &frame_lights, shadows, &LitSettings { receivers: from, ..settings })
-            .unwrap();
+    let both = FrameShadows { direct: &technique, indirect: &technique };
+    for from in [ReferenceReceivers::ReadStats, ReferenceReceivers::CpuPoints] {
+        let frame = lit.render_reference(&gpu, &geometry, &view, &frame_lights, both, &settings, from).unwrap();
         gpu.wait(None).unwrap();
         assert_eq!(read_hdr(&gpu, &frame.finish_reports(&gpu).unwrap().0).unwrap(), shadowed, "{from:?}");
     }

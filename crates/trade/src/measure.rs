@@ -10,8 +10,8 @@ use envmap_sphere::EnvMap;
 use glam::Vec3;
 use gpu::{
     Background, FrameLights, FrameShadows, GBufferPass, Gpu, JointBilateral, LightShape, LitFrame, LitSettings,
-    PrefilterSettings, ReceiversFrom, RotatedGrid, SceneGeometry, ShadeLight, ShadingPass, ShadowPassReport,
-    ShadowTechnique, SpecularAmbient, SplitSettings,
+    PrefilterSettings, RotatedGrid, SceneGeometry, ShadeLight, ShadingPass, ShadowPassReport, ShadowTechnique,
+    SpecularAmbient, SplitSettings,
 };
 use light_extract::Decomposition;
 use penumbra_wedge::{WedgeSettings, Wedges};
@@ -186,7 +186,6 @@ fn frame(
                 upsample: JointBilateral::PAPER,
             },
             weber: setting.weber,
-            receivers: ReceiversFrom::Gpu,
             time_lights: true,
         },
     )?;
