@@ -256,7 +256,7 @@ pub fn run(args: &TradeArgs) -> Result<(), String> {
             Unit::Point(scene) => {
                 outln!("[{elapsed:>6.1} s] {scene}'s point lights: truth (ray-traced visibility)");
                 let case = PointCase::new(&gpu, &passes, scene, &plan).map_err(e)?;
-                run.rows.extend(trade::measure_point(&gpu, &passes, &case, &settings, &plan, &mut show).map_err(e)?);
+                run.rows.extend(trade::measure_point(&gpu, &case, &settings, &plan, &mut show).map_err(e)?);
             }
             Unit::Composite(scene) => {
                 outln!("[{elapsed:>6.1} s] a sphere composited into {scene}: capture, hierarchy, truth");

@@ -167,7 +167,7 @@ fn frame(
     let shapes: Vec<LightShape> = d.lights.iter().map(|l| LightShape::from(&l.light)).collect();
     let directs = if technique.is_some() && setting.indirect_scale > 1 { d.directs() } else { lights.len() };
     let view = GBufferPass::camera_view(input.geometry, input.camera);
-    let mut rendered = input.lit.render(
+    let rendered = input.lit.render(
         gpu,
         input.geometry,
         &view,
@@ -189,6 +189,15 @@ fn frame(
             time_lights: true,
         },
     )?;
+    finished(gpu, rendered, technique)
+}
+
+/// A recorded frame waited for, its image and its reports completed with what the GPU knew.
+pub(crate) fn finished(
+    gpu: &Gpu,
+    mut rendered: gpu::RenderedFrame,
+    technique: Option<&dyn ShadowTechnique>,
+) -> Result<(wgpu::Texture, Vec<ShadowPassReport>), TradeError> {
     gpu.wait(None)?;
     if let Some(t) = technique {
         // what only the GPU knew (its wedges' counts), in record order, before the lights the
@@ -274,7 +283,7 @@ pub fn measure(
 }
 
 /// What an env or point frame's `ms` measures.
-const FRAME_CLOCK: &str = "wall time (the recorded frame: its submissions and one wait)";
+pub(crate) const FRAME_CLOCK: &str = "wall time (the recorded frame: its submissions and one wait)";
 
 /// `plan.repeats` frames of `frame` timed: the last frame and the median milliseconds.
 /// Pipelines compile and buffers grow on the first frame: a median of 3 or more drops it,

@@ -5,15 +5,12 @@
 
 use crate::TradeError;
 use crate::front::Measurement;
-use crate::measure::{Passes, Plan, Shadows, technique, timed};
-
-/// What a point frame's `ms` measures.
-const FRAME_CLOCK: &str = "wall time (frame: submits + waits, the G-buffer's points read back)";
+use crate::measure::{FRAME_CLOCK, Passes, Plan, Shadows, finished, technique, timed};
 use crate::setting::Setting;
 use glam::Vec3;
 use gpu::{
-    Gpu, LightShape, PrecomputedVisibility, Receivers, RotatedGrid, SceneGeometry, ShadeLight, ShadeParams,
-    ShadowPassReport, ShadowTechnique, Visibility, render_visibility,
+    FrameLights, FrameShadows, GBufferPass, Gpu, LightShape, LitFrame, LitSettings, PrecomputedVisibility, RotatedGrid,
+    SceneGeometry, ShadeLight, ShadowPassReport, ShadowTechnique,
 };
 use ref_tracer::SceneBvh;
 use ref_tracer::metrics::{FlipTonemap, flip, rmse};
@@ -25,6 +22,7 @@ pub struct PointCase {
     pub scene: scene::Scene,
     grid: RotatedGrid,
     geometry: SceneGeometry,
+    lit: LitFrame,
     lights: Vec<ShadeLight>,
     shapes: Vec<LightShape>,
     truth: Vec<Vec3>,
@@ -47,8 +45,18 @@ impl PointCase {
         let geometry = SceneGeometry::upload(gpu, &scene)?;
         let lights: Vec<ShadeLight> = scene.point_lights.iter().map(ShadeLight::from).collect();
         let shapes: Vec<LightShape> = scene.point_lights.iter().map(LightShape::from).collect();
-        let mut case =
-            Self { scene, grid, geometry, lights, shapes, truth: Vec::new(), tonemap: FlipTonemap::for_reference(&[]) };
+        let camera = grid.camera();
+        let lit = LitFrame::new(gpu, (camera.width, camera.height))?;
+        let mut case = Self {
+            scene,
+            grid,
+            geometry,
+            lit,
+            lights,
+            shapes,
+            truth: Vec::new(),
+            tonemap: FlipTonemap::for_reference(&[]),
+        };
         let gb = passes.gbuffer.render(gpu, &case.geometry, case.grid.camera())?;
         let points = gb.read_points(gpu)?;
         let bvh = SceneBvh::new(&case.scene);
@@ -63,7 +71,7 @@ impl PointCase {
             })
             .collect();
         let traced = PrecomputedVisibility::new(gpu, "ray_traced", gb.size(), layers)?;
-        let (image, _) = case.frame(gpu, passes, &traced)?;
+        let (image, _) = case.frame(gpu, &traced)?;
         case.truth = case.grid.resolve(&gpu::read_hdr(gpu, &image)?);
         case.tonemap = FlipTonemap::for_reference(&case.truth);
         Ok(case)
@@ -75,22 +83,27 @@ impl PointCase {
         &self.truth
     }
 
-    /// One frame: G-buffer, the lights' visibility by `technique`, shading.
+    /// One frame, the toolkit's recorded frame ([`gpu::LitFrame`]) waited for and its lights
+    /// timed, every light shadowed by `technique` at full resolution (no Weber skipping: the
+    /// truth skips none).
     fn frame(
         &self,
         gpu: &Gpu,
-        passes: &Passes,
         technique: &dyn ShadowTechnique,
     ) -> Result<(wgpu::Texture, Vec<ShadowPassReport>), TradeError> {
-        let gb = passes.gbuffer.render(gpu, &self.geometry, self.grid.camera())?;
-        let (w, h) = gb.size();
-        let vis = Visibility::new(gpu, w, h, self.lights.len() as u32)?;
-        let points = gb.read_points(gpu)?;
-        let receivers = Receivers::new(&gb, &points);
-        let reports = render_visibility(gpu, technique, &receivers, &self.shapes, &[], &vis)?;
-        let params = ShadeParams { lights: &self.lights, ambient: None, background: None, specular_ambient: None };
-        let image = passes.shading.render_texture(gpu, &self.geometry, &gb, &params, &vis)?;
-        Ok((image, reports))
+        let view = GBufferPass::camera_view(&self.geometry, self.grid.camera());
+        let lights = FrameLights {
+            lights: &self.lights,
+            shapes: &self.shapes,
+            directs: self.lights.len(),
+            ambient: None,
+            specular_ambient: None,
+            background: None,
+        };
+        let shadows = FrameShadows { direct: technique, indirect: technique };
+        let settings = LitSettings { weber: false, time_lights: true, ..LitSettings::default() };
+        let rendered = self.lit.render(gpu, &self.geometry, &view, &lights, Some(shadows), &settings)?;
+        finished(gpu, rendered, Some(technique))
     }
 }
 
@@ -101,7 +114,6 @@ impl PointCase {
 /// A technique that cannot shadow point lights; GPU failures.
 pub fn measure_point(
     gpu: &Gpu,
-    passes: &Passes,
     case: &PointCase,
     settings: &[Setting],
     plan: &Plan,
@@ -113,7 +125,7 @@ pub fn measure_point(
         let technique = technique(gpu, &case.scene, &setting.shadow)?
             .filter(|_| setting.shadow.for_point_lights())
             .ok_or_else(|| TradeError::Render(format!("{}: not a point-light technique", knobs.name())))?;
-        let ((image, reports), ms) = timed(plan, || case.frame(gpu, passes, technique.as_ref()))?;
+        let ((image, reports), ms) = timed(plan, || case.frame(gpu, technique.as_ref()))?;
         let image = case.grid.resolve(&gpu::read_hdr(gpu, &image)?);
         let shadows = Shadows::of(&reports);
         let m = Measurement {

@@ -96,7 +96,7 @@ fn point_maps_are_measured_against_ray_traced_visibility() {
         // other families' settings are left to their own cases
         Setting::new(trade::BEST_METHOD, 4, Shadow::Wedges),
     ];
-    let rows = measure_point(&gpu, &passes, &case, &settings, &plan, &mut |_| {}).expect("measured");
+    let rows = measure_point(&gpu, &case, &settings, &plan, &mut |_| {}).expect("measured");
     assert_eq!(rows.len(), 3);
     let truth = case.truth();
     let rms = (truth.iter().map(|p| f64::from(p.length_squared())).sum::<f64>() / (3 * truth.len()) as f64).sqrt();
@@ -108,7 +108,7 @@ fn point_maps_are_measured_against_ray_traced_visibility() {
     }
     // paper 004's caveat: a paraboloid bends straight edges, long triangles need subdividing
     assert!(rows[0].rmse < rows[1].rmse, "subdivided {} unsubdivided {}", rows[0].rmse, rows[1].rmse);
-    let e = measure_point(&gpu, &passes, &case, &[point(Shadow::Wedges)], &plan, &mut |_| {})
+    let e = measure_point(&gpu, &case, &[point(Shadow::Wedges)], &plan, &mut |_| {})
         .expect_err("wedges do not shadow point lights here");
     assert!(e.to_string().contains("not a point-light technique"), "{e}");
     assert!(PointCase::new(&gpu, &passes, "three_boxes", &plan).is_err(), "no point lights");
