@@ -250,12 +250,18 @@ impl LitFrame {
         self.check(lights, true, settings)?;
         let mut encoder = gpu.encoder("reference g-buffers");
         let (gb, low_gb) = self.record_gbuffers(gpu, &mut encoder, geometry, view, lights, settings)?;
+        // one submission: the G-buffers, and the reduction where it is what is read back
+        let pending = match from {
+            ReferenceReceivers::ReadStats => {
+                self.record_reductions(gpu, &mut encoder, (&gb, low_gb.as_ref()), lights, settings)?
+            }
+            ReferenceReceivers::CpuPoints => Vec::new(),
+        };
+        gpu.submit(encoder);
         let points;
-        let stats;
         // the receivers with their Weber flags, full resolution and low
         let (receivers, low) = match from {
             ReferenceReceivers::CpuPoints => {
-                gpu.submit(encoder);
                 points = (gb.read_points(gpu)?, low_gb.as_ref().map(|l| l.read_points(gpu)).transpose()?);
                 let weber = |r: &Receivers| {
                     if settings.weber {
@@ -270,13 +276,13 @@ impl LitFrame {
                 ((full, full_flags), low.zip(low_flags))
             }
             ReferenceReceivers::ReadStats => {
-                let pending = self.record_reductions(gpu, &mut encoder, (&gb, low_gb.as_ref()), lights, settings)?;
-                gpu.submit(encoder);
-                stats = PendingStats::read_all(gpu, pending)?;
-                let last = &stats[stats.len() - 1];
-                let low =
-                    low_gb.as_ref().map(|l| (Receivers::from_stats(l, last, lights.shapes), last.negligible.clone()));
-                ((Receivers::from_stats(&gb, &stats[0], lights.shapes), stats[0].negligible.clone()), low)
+                let mut stats = PendingStats::read_all(gpu, pending)?;
+                // the low G-buffer's statistics last (the full-resolution ones when there is none)
+                let last = stats.len() - 1;
+                let full = Receivers::from_stats(&gb, &stats[0], lights.shapes);
+                let low = low_gb.as_ref().map(|l| Receivers::from_stats(l, &stats[last], lights.shapes));
+                let low_flags = low.as_ref().map(|_| std::mem::take(&mut stats[last].negligible));
+                ((full, std::mem::take(&mut stats[0].negligible)), low.zip(low_flags))
             }
         };
         let low = low.as_ref().map(|(r, n)| (r, n.as_slice()));
