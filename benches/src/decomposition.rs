@@ -14,9 +14,6 @@ use penumbra_wedge::{WedgeSettings, Wedges};
 use shadowmap_paraboloid::{MapTechnique, ShadowSettings, Technique};
 use std::time::{Duration, Instant};
 
-/// The extraction the frame draws: the toolkit's most accurate (validate's default).
-pub const METHOD: &str = "emissive-split+moment-cones+above-horizon+residual";
-
 /// The EnvIndirects' maps: 1024², 3 x 3 PCF.
 fn maps_settings() -> ShadowSettings {
     ShadowSettings { resolution: 1024, pcf_radius: 1, ..ShadowSettings::default() }
@@ -86,7 +83,7 @@ impl Frame {
     /// An unknown method; GPU failures.
     pub fn with_scene(gpu: &Gpu, scene: scene::Scene, map: &EnvMap, lights: usize) -> Result<Self, String> {
         let e = |e: GpuError| e.to_string();
-        let extractor = light_extract::extractor(METHOD, lights).ok_or("unknown method")?;
+        let extractor = light_extract::extractor(light_extract::DEFAULT_METHOD, lights).ok_or("unknown method")?;
         let mut decomposition = extractor.extract(map).map_err(|e| e.to_string())?;
         decomposition.sort_directs_first();
         let size = (scene.camera.width, scene.camera.height);

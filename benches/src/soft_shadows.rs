@@ -2,6 +2,11 @@
 //! visibility of the whole light, and its GPU time per light, per scene and light size; and the
 //! speed of each at the wedges' error. `cargo xtask soft-shadows` prints it; the criterion
 //! bench `soft_shadows` times the techniques.
+//!
+//! A technique bench, not a frame: it measures one light's visibility layer, which no frame
+//! shows alone, through `gpu::render_visibility` (`record_visibility`, the recording
+//! `gpu::LitFrame` makes of every light, submitted once and timed); its receivers are the
+//! G-buffer's points, which the ray-traced truth needs anyway.
 
 use glam::Vec3;
 use gpu::{

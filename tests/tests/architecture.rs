@@ -166,3 +166,215 @@ fn the_trade_meets_techniques_only_through_the_trait() {
     }
     assert_eq!(builders, 2, "measure.rs builds wedges and maps in `technique`");
 }
+
+/// The module names `text` uses through `prefix` (`crate::` or `super::`), among `names`.
+fn used_modules(text: &str, prefix: &str, names: &BTreeSet<String>) -> BTreeSet<String> {
+    let mut used = BTreeSet::new();
+    let mut rest = text;
+    while let Some(i) = rest.find(prefix) {
+        rest = &rest[i + prefix.len()..];
+        let word: String = rest.chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect();
+        if names.contains(&word) {
+            used.insert(word);
+        }
+        // `use crate::{a, b}` and `use super::{a::X, b}`
+        if rest.starts_with('{') {
+            let group = &rest[1..rest.find('}').unwrap_or(rest.len())];
+            for part in group.split(',') {
+                let word: String = part.trim().chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect();
+                if names.contains(&word) {
+                    used.insert(word);
+                }
+            }
+        }
+    }
+    used
+}
+
+/// The first cycle of a graph, if any, as the path that closes it.
+fn cycle(graph: &HashMap<String, BTreeSet<String>>) -> Option<Vec<String>> {
+    fn visit(
+        n: &str,
+        graph: &HashMap<String, BTreeSet<String>>,
+        path: &mut Vec<String>,
+        done: &mut BTreeSet<String>,
+    ) -> Option<Vec<String>> {
+        if let Some(i) = path.iter().position(|p| p == n) {
+            let mut c = path[i..].to_vec();
+            c.push(n.to_string());
+            return Some(c);
+        }
+        if done.contains(n) {
+            return None;
+        }
+        path.push(n.to_string());
+        for d in graph.get(n).into_iter().flatten() {
+            if let Some(c) = visit(d, graph, path, done) {
+                return Some(c);
+            }
+        }
+        path.pop();
+        done.insert(n.to_string());
+        None
+    }
+    let mut done = BTreeSet::new();
+    let mut keys: Vec<_> = graph.keys().collect();
+    keys.sort();
+    keys.into_iter().find_map(|k| visit(k, graph, &mut Vec::new(), &mut done))
+}
+
+#[test]
+fn cycle_finds_a_circle_and_passes_a_tree() {
+    let g = |edges: &[(&str, &str)]| {
+        let mut m: HashMap<String, BTreeSet<String>> = HashMap::new();
+        for (a, b) in edges {
+            m.entry(a.to_string()).or_default().insert(b.to_string());
+        }
+        m
+    };
+    assert_eq!(cycle(&g(&[("a", "b"), ("b", "c"), ("a", "c")])), None);
+    assert_eq!(
+        cycle(&g(&[("a", "b"), ("b", "c"), ("c", "a")])),
+        Some(vec!["a".into(), "b".into(), "c".into(), "a".into()])
+    );
+    let names: BTreeSet<String> = ["shafts", "validate"].into_iter().map(String::from).collect();
+    let used = used_modules("use crate::{shafts::x, validate};\nlet y = crate::shafts::z;", "crate::", &names);
+    assert_eq!(used, names);
+}
+
+#[test]
+fn xtask_modules_form_a_tree_not_a_circle() {
+    // A command module may use the leaves (`common`, `lavapipe`, `thresholds`) and run another
+    // command, but no two modules reach each other: `xtask/src`'s top-level modules through
+    // `crate::`, and the sibling modules of each folder through `super::`.
+    let root = workspace_tests::workspace_root().join("xtask/src");
+    let mut dirs = vec![(root.clone(), "crate::")];
+    for entry in std::fs::read_dir(&root).expect("read xtask/src").flatten() {
+        if entry.path().is_dir() {
+            dirs.push((entry.path(), "super::"));
+        }
+    }
+    let mut edges = 0;
+    for (dir, prefix) in dirs {
+        let mut files: HashMap<String, String> = HashMap::new();
+        for entry in std::fs::read_dir(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display())).flatten() {
+            let p = entry.path();
+            let name = p.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default();
+            if name == "main" || name == "mod" {
+                continue;
+            }
+            let text = if p.is_dir() {
+                let mut all = String::new();
+                let mut sources = Vec::new();
+                workspace_tests::collect(&p, "rs", &mut sources);
+                for s in sources {
+                    all.push_str(&std::fs::read_to_string(&s).unwrap_or_default());
+                }
+                all
+            } else if p.extension().is_some_and(|x| x == "rs") {
+                std::fs::read_to_string(&p).unwrap_or_default()
+            } else {
+                continue;
+            };
+            files.insert(name, text);
+        }
+        let names: BTreeSet<String> = files.keys().cloned().collect();
+        let graph: HashMap<String, BTreeSet<String>> = files
+            .iter()
+            .map(|(n, text)| {
+                let mut used = used_modules(text, prefix, &names);
+                used.remove(n);
+                (n.clone(), used)
+            })
+            .collect();
+        edges += graph.values().map(BTreeSet::len).sum::<usize>();
+        assert_eq!(cycle(&graph), None, "{}: modules that reach each other", dir.display());
+    }
+    assert!(edges > 5, "read only {edges} edges between xtask's modules");
+}
+
+/// The `"..."` arguments of `macro!("...")` calls in `text`.
+fn included_paths<'a>(text: &'a str, macro_name: &str) -> Vec<&'a str> {
+    let open = format!("{macro_name}!(\"");
+    text.match_indices(&open)
+        .filter_map(|(i, _)| {
+            let rest = &text[i + open.len()..];
+            rest.find('"').map(|end| &rest[..end])
+        })
+        .collect()
+}
+
+#[test]
+fn every_library_crate_packages_the_files_it_includes() {
+    // A crate stands alone when its package holds what its sources include: shaders, tables,
+    // the embedded map. `cargo package --list` is what a published copy would hold.
+    let root = workspace_tests::workspace_root();
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let mut checked = 0;
+    for entry in std::fs::read_dir(root.join("crates")).expect("read crates/").flatten() {
+        let dir = entry.path();
+        let manifest = std::fs::read_to_string(dir.join("Cargo.toml")).unwrap_or_default();
+        let Some(name) = manifest.lines().find_map(|l| l.strip_prefix("name = \"")).and_then(|l| l.strip_suffix('"'))
+        else {
+            continue;
+        };
+        let out = Command::new(&cargo)
+            .args(["package", "--list", "--allow-dirty", "-p", name])
+            .current_dir(&root)
+            .output()
+            .expect("run cargo package --list");
+        assert!(out.status.success(), "{name}: {}", String::from_utf8_lossy(&out.stderr));
+        let listed: BTreeSet<String> = String::from_utf8_lossy(&out.stdout).lines().map(str::to_string).collect();
+        let mut sources = Vec::new();
+        workspace_tests::collect(&dir.join("src"), "rs", &mut sources);
+        for source in sources {
+            let text = std::fs::read_to_string(&source).unwrap_or_default();
+            for included in
+                included_paths(&text, "include_str").into_iter().chain(included_paths(&text, "include_bytes"))
+            {
+                let path = source.parent().expect("a source's folder").join(included);
+                let path =
+                    std::fs::canonicalize(&path).unwrap_or_else(|e| panic!("{}: {included}: {e}", source.display()));
+                let dir = std::fs::canonicalize(&dir).expect("the crate's folder");
+                let rel = path
+                    .strip_prefix(&dir)
+                    .unwrap_or_else(|_| panic!("{}: includes {included}, outside crate {name}", source.display()));
+                let rel = rel.to_string_lossy().replace('\\', "/");
+                assert!(listed.contains(&rel), "{name}'s package lacks {rel} ({} includes it)", source.display());
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 20, "checked only {checked} included files");
+}
+
+#[test]
+fn the_code_map_names_every_crate_with_its_invariant() {
+    // docs/architecture.md, the rust-analyzer way: an entry per crate, a few lines each, its
+    // invariant, and whether it is an API boundary
+    let root = workspace_tests::workspace_root();
+    let doc = std::fs::read_to_string(root.join("docs/architecture.md")).expect("read docs/architecture.md");
+    let mut members: Vec<String> = std::fs::read_dir(root.join("crates"))
+        .expect("read crates/")
+        .flatten()
+        .filter(|e| e.path().join("Cargo.toml").is_file())
+        .map(|e| format!("crates/{}", e.file_name().to_string_lossy()))
+        .collect();
+    members.extend(["benches", "xtask", "tests"].map(String::from));
+    assert!(members.len() >= 15, "found only {members:?}");
+    for member in members {
+        let heading = format!("### `{member}`");
+        let start = doc.find(&heading).unwrap_or_else(|| panic!("docs/architecture.md has no `{heading}`"));
+        let body = &doc[start + heading.len()..];
+        let body = &body[..body.find("\n#").unwrap_or(body.len())];
+        let (what, rule) = body
+            .split_once("**Architecture invariant:**")
+            .unwrap_or_else(|| panic!("{member}: no **Architecture invariant:**"));
+        let lines = what.trim().lines().count();
+        assert!((2..=6).contains(&lines), "{member}: {lines} lines before its invariant (3-6 wanted)");
+        assert!(
+            rule.contains("**API boundary") || rule.contains("Internal"),
+            "{member}: neither **API boundary** nor Internal"
+        );
+    }
+}

@@ -1,36 +1,43 @@
-//! Every WGSL file under `shaders/` parses and validates with naga, composed with the library
-//! files its `// requires:` lines name, by `gpu::shader::compose_with` as at run time. Each shader
-//! sits in `shaders/<crate>/` of the crate whose pass owns it.
+//! Every WGSL file parses and validates with naga, composed with the library files its
+//! `// requires:` lines name, by `gpu::shader::compose_with` as at run time. Each shader sits in
+//! `crates/<crate>/shaders/` of the crate whose pass owns it, so each crate packages its own.
 
 use std::path::{Path, PathBuf};
 use workspace_tests::{collect, workspace_root};
 
 fn shaders() -> Vec<PathBuf> {
     let mut out = Vec::new();
-    collect(&workspace_root().join("shaders"), "wgsl", &mut out);
+    collect(&workspace_root().join("crates"), "wgsl", &mut out);
     out.sort();
     out
 }
 
-/// The file composed as at run time (`gpu::shader::compose_with`), its library files read from
-/// `shaders/`.
+/// The file composed as at run time (`gpu::shader::compose_with`), a library file `<crate>/<file>`
+/// read from `crates/<crate>/shaders/<file>`.
 fn compose(path: &Path) -> Result<String, String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let read = |name: &str| {
-        let lib = workspace_root().join("shaders").join(name);
+        let (krate, file) =
+            name.split_once('/').ok_or_else(|| format!("{} requires {name}: not <crate>/<file>", path.display()))?;
+        let lib = workspace_root().join("crates").join(krate).join("shaders").join(file);
         std::fs::read_to_string(&lib).map_err(|e| format!("{} requires {name}: {e}", path.display()))
     };
     gpu::shader::compose_with(&text, read)
 }
 
 #[test]
-fn every_shader_lives_in_a_crate_folder() {
+fn every_shader_lives_in_its_crates_shaders_folder() {
+    // A shader outside `crates/<crate>/shaders/` would not be packaged with the crate that
+    // includes it; and no shader is left at the workspace root.
     let root = workspace_root();
-    for p in shaders() {
-        let rel = p.strip_prefix(root.join("shaders")).unwrap_or(&p);
-        let krate = rel.components().next().map(|c| c.as_os_str().to_string_lossy().to_string()).unwrap_or_default();
-        assert!(root.join("crates").join(&krate).is_dir(), "{}: shaders/{krate}/ names no crate", p.display());
+    let files = shaders();
+    assert!(!files.is_empty(), "no shader found under crates/");
+    for p in files {
+        let rel = p.strip_prefix(root.join("crates")).unwrap_or(&p);
+        let parts: Vec<_> = rel.components().map(|c| c.as_os_str().to_string_lossy().to_string()).collect();
+        assert!(parts.len() == 3 && parts[1] == "shaders", "{}: not crates/<crate>/shaders/<file>", p.display());
     }
+    assert!(!root.join("shaders").exists(), "a shaders/ folder at the workspace root");
 }
 
 #[test]

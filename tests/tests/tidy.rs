@@ -58,7 +58,7 @@ fn nothing_reads_beside_the_repository() {
     let beside = concat!("..", "/shared");
     let root = workspace_root();
     let mut files = rust_sources();
-    for (dir, ext) in [(".", "toml"), ("crates", "toml"), ("xtask", "toml"), (".ci", "run"), ("shaders", "wgsl")] {
+    for (dir, ext) in [(".", "toml"), ("crates", "toml"), ("xtask", "toml"), (".ci", "run"), ("crates", "wgsl")] {
         workspace_tests::collect(&root.join(dir), ext, &mut files);
     }
     files.push(root.join(".ci/run"));
@@ -96,4 +96,56 @@ fn library_errors_are_typed() {
         }
     }
     assert!(hits.is_empty(), "String errors from library functions:\n{}", hits.join("\n"));
+}
+
+#[test]
+fn every_workspace_dependency_is_used() {
+    // `[workspace.dependencies]` declares each dependency once; one no member names is dead
+    // weight in the lock file and in every reader's head.
+    let root = workspace_root();
+    let top = std::fs::read_to_string(root.join("Cargo.toml")).expect("read Cargo.toml");
+    let table = top.split("[workspace.dependencies]").nth(1).expect("a [workspace.dependencies] table");
+    let table = table.split("\n[").next().unwrap_or_default();
+    let declared: Vec<&str> = table
+        .lines()
+        .filter(|l| !l.trim_start().starts_with('#'))
+        .filter_map(|l| l.split_once('=').map(|(k, _)| k.trim()))
+        .filter(|k| !k.is_empty())
+        .collect();
+    assert!(declared.len() > 10, "read only {} workspace dependencies", declared.len());
+    let mut manifests = Vec::new();
+    workspace_tests::collect(&root.join("crates"), "toml", &mut manifests);
+    manifests.extend([root.join("xtask/Cargo.toml"), root.join("tests/Cargo.toml"), root.join("benches/Cargo.toml")]);
+    let members: String = manifests
+        .iter()
+        .filter(|m| m.ends_with("Cargo.toml"))
+        .map(|m| std::fs::read_to_string(m).unwrap_or_else(|e| panic!("{}: {e}", m.display())))
+        .collect();
+    let unused: Vec<&&str> =
+        declared.iter().filter(|d| !members.contains(&format!("\n{d}.workspace = true"))).collect();
+    assert!(unused.is_empty(), "workspace dependencies no member uses: {unused:?}");
+}
+
+#[test]
+fn no_library_crate_reads_the_repositorys_folders() {
+    // A library's API works from a published copy of the crate: it never reaches above its own
+    // folder (`../..` from its manifest) for data. The harness `test-set` is the one crate
+    // meant to (it is the repository's test data), and tests may.
+    let root = workspace_root();
+    let mut hits = Vec::new();
+    for entry in std::fs::read_dir(root.join("crates")).expect("read crates/").flatten() {
+        let krate = entry.path();
+        if krate.file_name().is_some_and(|n| n == "test-set") {
+            continue;
+        }
+        let mut sources = Vec::new();
+        workspace_tests::collect(&krate.join("src"), "rs", &mut sources);
+        for p in sources {
+            let text = std::fs::read_to_string(&p).unwrap_or_default();
+            if text.contains(concat!("CARGO_MANIFEST_DIR\")).join(\"../", "..")) || text.contains("\"../../../") {
+                hits.push(p.display().to_string());
+            }
+        }
+    }
+    assert!(hits.is_empty(), "library sources that read the repository's folders:\n{}", hits.join("\n"));
 }

@@ -12,7 +12,7 @@ use glam::Vec3;
 use real_scene::{Perturbation, PhotoSettings, RealScene};
 use shaft_hierarchy::preprocess::PreprocessSettings;
 
-use crate::parse_size;
+use crate::common::parse_size;
 
 /// The command's options.
 #[derive(clap::Args)]
@@ -112,7 +112,7 @@ pub fn run(args: &CompositeArgs) -> Result<(), String> {
     let gpu = crate::lavapipe::open_gpu(args.adapter.as_deref())?;
     say(&format!("GPU: {}", gpu.describe()));
     let probe = RealScene::builtin(&args.scene).map_err(|e| e.to_string())?;
-    let (map, lights) = crate::shafts::environment(&probe)?;
+    let (map, lights) = crate::common::environment(&probe)?;
     let settings = SessionSettings {
         size: Some(args.size),
         photo: PhotoSettings { spp: args.spp, ..SessionSettings::default().photo },

@@ -5,7 +5,7 @@
 //! and `DIR/eval-lights.json` (what `eval-lights merge` joins: a map library's shards, each run
 //! with `--shard I/N`).
 
-use crate::render::load_map;
+use crate::common::load_map;
 use clap::{Args, Subcommand};
 use light_extract::{EmissiveSplit, LightExtractor};
 use ref_tracer::metrics::{FlipTonemap, flip, rmse};
@@ -41,7 +41,7 @@ pub struct EvalLightsArgs {
     #[arg(long, default_value_t = 32)]
     lights_spp: u32,
     /// Image size WIDTHxHEIGHT.
-    #[arg(long, value_parser = crate::parse_size, default_value = "160x120")]
+    #[arg(long, value_parser = crate::common::parse_size, default_value = "160x120")]
     size: (u32, u32),
     /// This run's share of the maps, I/N (0-based): maps sorted by name, dealt round-robin.
     #[arg(long, default_value = "0/1")]
@@ -187,8 +187,8 @@ fn methods(k: usize) -> Vec<Method> {
 }
 
 fn run(args: &EvalLightsArgs) -> Result<(), String> {
-    let dir = args.maps.clone().unwrap_or_else(envmap_sphere::test_set::dir);
-    let all = envmap_sphere::test_set::maps_in(&dir).map_err(|e| e.to_string())?;
+    let dir = args.maps.clone().unwrap_or_else(test_set::dir);
+    let all = test_set::maps_in(&dir).map_err(|e| e.to_string())?;
     if all.is_empty() {
         return Err(format!("{}: no .exr or .hdr maps", dir.display()));
     }

@@ -40,7 +40,7 @@ pub fn run(args: &FrameArgs) -> Result<(), String> {
     if !args.json {
         outln!("GPU: {}", gpu.describe());
     }
-    let map = crate::render::load_map(args.envmap)?;
+    let map = crate::common::load_map(args.envmap)?;
     let mut frame = Frame::new(&gpu, args.scene, args.size, &map, args.lights)?;
     let moving = args.animate.then(|| animated_object(&frame.scene));
     let d = &frame.decomposition;
@@ -52,7 +52,7 @@ pub fn run(args: &FrameArgs) -> Result<(), String> {
             frame.scene.triangle_count(),
             args.size.0,
             args.size.1,
-            envshadow_benches::decomposition::METHOD,
+            light_extract::DEFAULT_METHOD,
             lights - directs,
             moving.map_or(String::new(), |k| format!("; {} moving", frame.scene.objects[k].name))
         );

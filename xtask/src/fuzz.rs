@@ -32,10 +32,10 @@ fn thresholds_target() -> Target {
         name: "thresholds.json",
         extension: "json",
         format: Format::Json,
-        seeds: vec![crate::validate::THRESHOLDS.as_bytes().to_vec(), minimal],
+        seeds: vec![crate::thresholds::THRESHOLDS.as_bytes().to_vec(), minimal],
         run: Box::new(|bytes, path| {
             let text = std::str::from_utf8(bytes).map_err(|e| format!("{}: not UTF-8: {e}", path.display()))?;
-            crate::validate::parse_thresholds(text, &path.display().to_string()).map(|_| ())
+            crate::thresholds::parse_thresholds(text, &path.display().to_string()).map(|_| ())
         }),
     }
 }

@@ -11,6 +11,7 @@ macro_rules! outln {
     }};
 }
 
+mod common;
 mod composite;
 mod eval_lights;
 mod extract;
@@ -23,10 +24,12 @@ mod scene;
 mod shafts;
 mod soft_shadows;
 mod test;
+mod thresholds;
 mod trade;
 mod validate;
 
 use clap::{Parser, Subcommand};
+use common::parse_size;
 
 /// The allocator with accounts: `fuzz` limits each case's memory and reports the peak.
 #[global_allocator]
@@ -218,11 +221,6 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-}
-
-pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s.split_once('x').ok_or("expected WIDTHxHEIGHT, e.g. 320x240")?;
-    Ok((w.parse().map_err(|e| format!("width: {e}"))?, h.parse().map_err(|e| format!("height: {e}"))?))
 }
 
 /// Set, the command line is parsed (clap's checks: subcommand, options, values) and nothing is

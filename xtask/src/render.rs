@@ -1,7 +1,7 @@
 //! `cargo xtask render`: the reference tracer on a built-in scene, with a progress bar and one
 //! summary line; and `cargo xtask compare REF TEST`: RMSE and FLIP.
 
-use crate::parse_size;
+use crate::common::parse_size;
 use envmap_sphere::{EnvMap, LoadOptions, NegativePolicy, Sh9, Tonemap};
 use glam::Vec3;
 use light_extract::output::{LightsFile, read_lights_json};
@@ -63,14 +63,6 @@ pub struct RenderArgs {
     pub env_sampling: String,
 }
 
-/// The map from `--envmap`, or the embedded default.
-pub fn load_map(path: Option<&Path>) -> Result<EnvMap, String> {
-    match path {
-        Some(p) => EnvMap::load(p).map_err(|e| e.to_string()),
-        None => Ok(envmap_sphere::default_map()),
-    }
-}
-
 /// What a `lights.json` holds for rendering.
 pub struct LightsData {
     pub lights: Vec<DistantLight>,
@@ -109,7 +101,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     if args.spp == 0 {
         return Err("--spp must be at least 1".into());
     }
-    let map = load_map(args.envmap.as_deref())?;
+    let map = crate::common::load_map(args.envmap.as_deref())?;
     let light_data = match &args.lights {
         Some(p) => Some(load_lights(p)?),
         None => None,

@@ -29,12 +29,6 @@ pub struct ShaftsArgs<'a> {
     pub out: &'a Path,
 }
 
-/// An environment-lit scene's map (the embedded one) and its extracted lights as distant
-/// sources; nothing for a scene lit by its own patches.
-pub fn environment(scene: &RealScene) -> Result<(Option<envmap_sphere::EnvMap>, Vec<scene::DistantLight>), String> {
-    differential_composite::setup::environment(scene, crate::validate::DEFAULT_METHOD, 32).map_err(|e| e.to_string())
-}
-
 pub fn run(args: &ShaftsArgs) -> Result<(), String> {
     let say = |s: &str| {
         if !args.json {
@@ -44,7 +38,7 @@ pub fn run(args: &ShaftsArgs) -> Result<(), String> {
     let mut scene = RealScene::builtin(args.scene).map_err(|e| e.to_string())?;
     let t = Instant::now();
     let bvh = PatchBvh::new(&scene);
-    let (map, lights) = environment(&scene)?;
+    let (map, lights) = crate::common::environment(&scene)?;
     let report =
         real_scene::solve(&mut scene, &bvh, map.as_ref(), &SolveSettings::default()).map_err(|e| e.to_string())?;
     say(&format!(

@@ -41,7 +41,7 @@ pub struct TradeArgs {
     #[arg(long, value_delimiter = ',')]
     maps: Vec<PathBuf>,
     /// Image size WIDTHxHEIGHT; 160x120 when absent (sized for lavapipe on 2 cores).
-    #[arg(long, value_parser = crate::parse_size)]
+    #[arg(long, value_parser = crate::common::parse_size)]
     size: Option<(u32, u32)>,
     /// Frames timed per setting (the median is kept; under 3, an untimed frame goes first).
     #[arg(long)]
@@ -81,7 +81,7 @@ fn map_list(paths: &[PathBuf], quick: bool) -> Result<Vec<MapSource>, String> {
         }
         let mut maps = vec![(envmap_sphere::DEFAULT_MAP_NAME.to_string(), None)];
         for name in DEFAULT_MAPS {
-            let p = envmap_sphere::test_set::path(name);
+            let p = test_set::path(name);
             maps.push((name.to_string(), Some(p)));
         }
         return Ok(maps);
@@ -89,7 +89,7 @@ fn map_list(paths: &[PathBuf], quick: bool) -> Result<Vec<MapSource>, String> {
     let mut out = Vec::new();
     for p in paths {
         if p.is_dir() {
-            let maps = envmap_sphere::test_set::maps_in(p).map_err(|e| e.to_string())?;
+            let maps = test_set::maps_in(p).map_err(|e| e.to_string())?;
             out.extend(maps.into_iter().map(|m| (file_name(&m), Some(m))));
         } else {
             out.push((file_name(p), Some(p.clone())));
@@ -260,7 +260,7 @@ pub fn run(args: &TradeArgs) -> Result<(), String> {
             }
             Unit::Composite(scene) => {
                 outln!("[{elapsed:>6.1} s] a sphere composited into {scene}: capture, hierarchy, truth");
-                let case = CompositeCase::new(&gpu, scene, trade::BEST_METHOD, &plan).map_err(e)?;
+                let case = CompositeCase::new(&gpu, scene, light_extract::DEFAULT_METHOD, &plan).map_err(e)?;
                 run.rows.extend(trade::measure_composite(&gpu, &case, &settings, &plan, &mut show).map_err(e)?);
             }
         }

@@ -17,7 +17,7 @@ fn fresh_dir(name: &str) -> PathBuf {
 }
 
 fn shared(name: &str) -> PathBuf {
-    envmap_sphere::test_set::path(name)
+    test_set::path(name)
 }
 
 #[test]

@@ -10,7 +10,7 @@
 //! the whole frame into the caller's encoder (no submission, wait or readback);
 //! `GpuCompositor::composite` measures the same stages, each waited for.
 //!
-//! Shaders: `shaders/differential-composite/`.
+//! Shaders: `crates/differential-composite/shaders/`.
 
 use std::time::{Duration, Instant};
 
@@ -187,14 +187,9 @@ impl GpuCompositor {
                 cache: None,
             })
         };
-        let masks = pipeline(
-            "composite masks",
-            &module("composite masks", include_str!("../../../shaders/differential-composite/masks.wgsl")),
-        );
-        let resolve = pipeline(
-            "composite resolve",
-            &module("composite resolve", include_str!("../../../shaders/differential-composite/resolve.wgsl")),
-        );
+        let masks = pipeline("composite masks", &module("composite masks", include_str!("../shaders/masks.wgsl")));
+        let resolve =
+            pipeline("composite resolve", &module("composite resolve", include_str!("../shaders/resolve.wgsl")));
         Ok(Self {
             pixels: storage("composite pixels", bytemuck::cast_slice(&table), wgpu::BufferUsages::empty()),
             photo_hdr: storage("photo hdr", bytemuck::cast_slice(&hdr), wgpu::BufferUsages::empty()),

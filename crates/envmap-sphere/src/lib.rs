@@ -12,8 +12,8 @@
 //! - Sampling in pbrt's style ([`EnvDistribution`]: `sample_dir` / `dir_pdf` /
 //!   `invert_dir_sample`, O(1) on average through guide tables, monotonic so stratified points
 //!   stay stratified), and a [`SummedAreaTable`] with f64 sums.
-//! - [`default_map`]: a real CC0 map embedded in the library; [`test_set`]: the repository's
-//!   eleven CC0 test maps.
+//! - [`default_map`]: a real CC0 map embedded in the library (the repository's eleven CC0 test
+//!   maps are the `test-set` harness crate's).
 //!
 //! Conventions (docs/conventions.md): right-handed, +Y up; linear Rec.709 radiance;
 //! Y = 0.2126 R + 0.7152 G + 0.0722 B; lat-long pixel (i, j) from the top-left,
@@ -45,7 +45,6 @@ pub mod layout;
 pub mod paraboloid;
 pub mod sat;
 pub mod sh;
-pub mod test_set;
 pub mod tonemap;
 
 pub use color::{Chromaticities, luminance};

@@ -96,10 +96,10 @@ struct ResolveSlot {
 }
 
 impl ResolvePass {
-    /// The mean of N lit tests: `clamp(r × scale)` (`shaders/gpu/resolve.wgsl`).
+    /// The mean of N lit tests: `clamp(r × scale)` (`crates/gpu/shaders/resolve.wgsl`).
     #[must_use]
     pub fn new(gpu: &Gpu) -> Self {
-        Self::with_shader(gpu, "resolve", include_str!("../../../shaders/gpu/resolve.wgsl"), &[])
+        Self::with_shader(gpu, "resolve", include_str!("../shaders/resolve.wgsl"), &[])
     }
 
     /// A resolve pass with its own fragment shader (`library`: WGSL files its `// requires:`

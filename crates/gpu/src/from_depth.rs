@@ -25,12 +25,8 @@ impl DepthGBufferPass {
     /// WebGPU's default limits).
     #[must_use]
     pub fn new(gpu: &Gpu) -> Self {
-        let module = crate::shader::module(
-            &gpu.device,
-            "gbuffer from depth",
-            include_str!("../../../shaders/gpu/from_depth.wgsl"),
-            &[],
-        );
+        let module =
+            crate::shader::module(&gpu.device, "gbuffer from depth", include_str!("../shaders/from_depth.wgsl"), &[]);
         let targets = [Some(GBUFFER_FORMAT.into()), Some(GBUFFER_FORMAT.into())];
         let pipeline = crate::fullscreen::pipeline_with_targets(gpu, "gbuffer from depth", &module, &targets);
         Self { pipeline }

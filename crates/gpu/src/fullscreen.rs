@@ -1,4 +1,4 @@
-//! Full-screen passes: one triangle covering the target (`shaders/gpu/fullscreen.wgsl`'s `vs`),
+//! Full-screen passes: one triangle covering the target (`crates/gpu/shaders/fullscreen.wgsl`'s `vs`),
 //! a fragment shader per pixel. The shading pass and every shadow technique's visibility pass
 //! are such passes.
 

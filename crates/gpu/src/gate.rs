@@ -1,7 +1,7 @@
 //! Lights gated on the GPU: which lights need a shadow pass (a visible receiver faces them and
 //! Weber's law does not find them negligible) stays where [`crate::ReceiverReduction`] found it,
 //! and each light's draws and dispatches are indirect, their arguments zeroed by a one-workgroup
-//! pass (`shaders/gpu/gate.wgsl`) when it needs none. The CPU records every light without
+//! pass (`crates/gpu/shaders/gate.wgsl`) when it needs none. The CPU records every light without
 //! waiting for the reduction; a skipped light costs the gate pass and the clears of its passes,
 //! not their draws. What was skipped is read back after the frame ([`crate::PendingStats`]).
 
@@ -37,7 +37,7 @@ impl GpuStats {
     /// Word of the bits of the 95th percentile of the points' distances to the mean.
     pub const RADIUS_WORD: u32 = 48;
 
-    /// The reduction's statistics, as `shaders/gpu/receivers.wgsl` lays them out (words at
+    /// The reduction's statistics, as `crates/gpu/shaders/receivers.wgsl` lays them out (words at
     /// [`GpuStats::COUNT_WORD`], [`GpuStats::MEAN_WORD`], [`GpuStats::RADIUS_WORD`]).
     #[must_use]
     pub fn buffer(&self) -> &wgpu::Buffer {

@@ -105,7 +105,7 @@ impl GBufferPass {
     }
 
     fn module(gpu: &Gpu) -> wgpu::ShaderModule {
-        crate::shader::module(&gpu.device, "gbuffer", include_str!("../../../shaders/gpu/gbuffer.wgsl"), &[])
+        crate::shader::module(&gpu.device, "gbuffer", include_str!("../shaders/gbuffer.wgsl"), &[])
     }
 
     /// A pipeline writing `targets` G-buffer targets; the first pass writes depth (reversed Z,

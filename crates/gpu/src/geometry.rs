@@ -15,7 +15,7 @@ struct ShadedVertex {
     object: u32,
 }
 
-/// Material as the shaders read it (`shaders/gpu/brdf.wgsl`).
+/// Material as the shaders read it (`crates/gpu/shaders/brdf.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 pub(crate) struct GpuMaterial {

@@ -5,16 +5,19 @@
 //! measurement wraps it ([`LitSettings::time_lights`], a wait after), it is not a second path.
 //!
 //! Everything it renders into is made once per size, scale and light count and rendered into
-//! frame after frame: a frame's image is overwritten by the next.
+//! frame after frame: a frame's image is overwritten by the next. Paper 001's interleaved light
+//! sets are the same frame drawn once per set, each gathered into one image
+//! ([`LitFrame::render_interleaved`]).
 
 use crate::ambient::SpecularAmbient;
 use crate::context::{Gpu, GpuError};
 use crate::gbuffer::{GBuffer, GBufferPass, GBufferTargets};
 use crate::geometry::SceneGeometry;
+use crate::interleave::{InterleavePass, MAX_SETS};
 use crate::receivers::{MappedStats, PendingStats, ReceiverReduction, WeberInput};
 use crate::shade::{Background, ShadeLight, ShadeParams, ShadingPass, Visibility};
 use crate::slots::Keyed;
-use crate::split::{SplitFrame, SplitPasses, SplitSettings, SplitTargets, indirect_size, record_split};
+use crate::split::{SplitFrame, SplitPasses, SplitSettings, SplitTargets, indirect_size, record_split_stamped};
 use crate::technique::{
     LightShape, LightStamps, Receivers, ShadowPassReport, ShadowTechnique, WEBER_FRACTION, record_visibility_stamped,
     weber_negligible,
@@ -126,6 +129,29 @@ impl RenderedFrame {
     }
 }
 
+/// An interleaved frame's image (submitted, not waited for) and its sets' frames, in order.
+pub struct InterleavedImage {
+    /// The gathered HDR image, which the next interleaved frame of the same size renders into.
+    pub texture: wgpu::Texture,
+    /// Each set's frame, for its reports (its own image is the next set's by now).
+    pub sets: Vec<RenderedFrame>,
+}
+
+impl InterleavedImage {
+    /// The gathered image and every set's reports, set after set, completed as
+    /// [`RenderedFrame::finish_reports`] completes one frame's. Read once the last set has run.
+    ///
+    /// # Errors
+    /// As [`RenderedFrame::finish_reports`].
+    pub fn finish_reports(self, gpu: &Gpu) -> Result<(wgpu::Texture, Vec<ShadowPassReport>), GpuError> {
+        let mut reports = Vec::new();
+        for set in self.sets {
+            reports.extend(set.finish_reports(gpu)?.1);
+        }
+        Ok((self.texture, reports))
+    }
+}
+
 /// Receivers and their Weber flags (per light of the frame; empty: none marked).
 type Flagged<'a> = (&'a Receivers<'a>, &'a [bool]);
 
@@ -147,6 +173,9 @@ pub struct LitFrame {
     direct_visibility: RefCell<Keyed<u32, Rc<Visibility>>>,
     // a frame without EnvIndirects: its one shaded image
     whole: RefCell<Keyed<(u32, u32), wgpu::Texture>>,
+    // interleaved light sets: the gathering pass and the gathered image
+    gather: InterleavePass,
+    interleaved: RefCell<Keyed<(u32, u32), wgpu::Texture>>,
 }
 
 impl LitFrame {
@@ -164,6 +193,8 @@ impl LitFrame {
             scales: RefCell::default(),
             direct_visibility: RefCell::default(),
             whole: RefCell::default(),
+            gather: InterleavePass::new(gpu),
+            interleaved: RefCell::default(),
         })
     }
 
@@ -290,6 +321,60 @@ impl LitFrame {
         self.record_lit(gpu, gpu.encoder("reference frame"), geometry, lights, Some(shadows), receivers, low, settings)
     }
 
+    /// Paper 001's interleaved sampling: each light set of `sets` drawn as a whole frame
+    /// ([`LitFrame::render`], or with `reference` [`LitFrame::render_reference`]) and its pixels
+    /// of the interleaving tile gathered into one image, one submission after each set's, no
+    /// wait. Each set is gated and flagged by Weber's law on its own lights. The techniques'
+    /// own counts ([`ShadowTechnique::read_counts`]) are the last set's once it has run.
+    ///
+    /// # Errors
+    /// No set; more than [`MAX_SETS`]; as [`LitFrame::render`].
+    #[allow(clippy::too_many_arguments)]
+    pub fn render_interleaved(
+        &self,
+        gpu: &Gpu,
+        geometry: &SceneGeometry,
+        view: &View,
+        sets: &[FrameLights],
+        shadows: FrameShadows<'_>,
+        settings: &LitSettings,
+        reference: Option<ReferenceReceivers>,
+    ) -> Result<InterleavedImage, GpuError> {
+        if sets.is_empty() {
+            return Err(GpuError::Failed("interleaving: no light set".into()));
+        }
+        if sets.len() > MAX_SETS as usize {
+            return Err(GpuError::TooLarge {
+                what: "interleaved light sets",
+                size: sets.len() as u64,
+                limit: MAX_SETS.into(),
+            });
+        }
+        let size = self.size();
+        let texture = self
+            .interleaved
+            .borrow_mut()
+            .try_get(size, || {
+                crate::target::render_target(gpu, "interleaved frame", (size.0, size.1, 1), crate::shade::HDR_FORMAT)
+            })?
+            .clone();
+        let n = sets.len() as u32;
+        let mut frames = Vec::with_capacity(sets.len());
+        for (k, lights) in (0..n).zip(sets) {
+            let frame = match reference {
+                None => self.render(gpu, geometry, view, lights, Some(shadows), settings)?,
+                Some(from) => self.render_reference(gpu, geometry, view, lights, shadows, settings, from)?,
+            };
+            // the set's image is the frame's target, which the next set renders into: gathered
+            // in a submission between the two
+            let mut encoder = gpu.encoder("interleave gather");
+            self.gather.record_gather(gpu, &mut encoder, (&frame.texture, &texture), n, k)?;
+            gpu.submit(encoder);
+            frames.push(frame);
+        }
+        Ok(InterleavedImage { texture, sets: frames })
+    }
+
     /// What a frame asks of its lights and settings, checked before anything is recorded.
     fn check(&self, lights: &FrameLights, shadowed: bool, settings: &LitSettings) -> Result<(), GpuError> {
         if lights.directs > lights.lights.len() || lights.shapes.len() != lights.lights.len() {
@@ -405,7 +490,7 @@ impl LitFrame {
                 (s.direct, receivers),
                 (&lights.shapes[..directs], negligible.get(..directs).unwrap_or(&[])),
                 &vis,
-                stamps.as_ref(),
+                stamps.as_ref().map(|s| (s, 0)),
             )?,
             None => Vec::new(),
         };
@@ -413,7 +498,7 @@ impl LitFrame {
             Some(shadows) if directs < lights.lights.len() => {
                 let targets = self.scale_targets(gpu, settings, lights)?;
                 let (low, low_negligible) = low.unwrap_or((receivers, negligible));
-                let split = record_split(
+                let split = record_split_stamped(
                     gpu,
                     &mut encoder,
                     &SplitPasses { gbuffer: &self.gbuffer, shading: &self.shading, upsample: &self.upsample },
@@ -423,6 +508,7 @@ impl LitFrame {
                     &SplitFrame { lit: *lights, targets: Some(&targets.1) },
                     shadows.indirect,
                     &settings.split,
+                    stamps.as_ref(),
                 )?;
                 reports.extend(split.indirect_reports);
                 split.texture

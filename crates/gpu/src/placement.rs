@@ -1,6 +1,6 @@
 //! Per-object transforms, applied on the GPU: geometry is uploaded in object space and a moved
 //! object changes one transform (`queue.write_buffer`, 128 bytes), not its vertices. A compute
-//! pass (`shaders/gpu/place.wgsl`), recorded into the frame's encoder before the geometry is
+//! pass (`crates/gpu/shaders/place.wgsl`), recorded into the frame's encoder before the geometry is
 //! drawn, writes every vertex's world position (and normals) from a copy of the uploaded ones.
 //!
 //! Only a scene that moves pays for it: the copy and the transform table are made at the first
@@ -152,8 +152,7 @@ impl Placement {
     /// The pass's pipeline, made once per device.
     fn pipeline(gpu: &Gpu) -> &wgpu::ComputePipeline {
         gpu.place.get_or_init(|| {
-            let module =
-                crate::shader::module(&gpu.device, "place", include_str!("../../../shaders/gpu/place.wgsl"), &[]);
+            let module = crate::shader::module(&gpu.device, "place", include_str!("../shaders/place.wgsl"), &[]);
             gpu.compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some("place"),
                 layout: None,

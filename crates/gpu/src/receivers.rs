@@ -1,4 +1,4 @@
-//! The receivers' statistics reduced on the GPU (`shaders/gpu/receivers.wgsl`): the bounds and
+//! The receivers' statistics reduced on the GPU (`crates/gpu/shaders/receivers.wgsl`): the bounds and
 //! count of the visible points, their mean, and per light whether any visible receiver faces
 //! it. What comes back is [`ReceiverStats::BYTES`] bytes, not the G-buffer's 32 a pixel: the
 //! first part of moving `Receivers` onto the GPU (`docs/real-time.md`, step 2). The CPU version
@@ -169,10 +169,9 @@ impl ReceiverReduction {
     /// Builds the pipelines.
     #[must_use]
     pub fn new(gpu: &Gpu) -> Self {
-        let module =
-            crate::shader::module(&gpu.device, "receivers", include_str!("../../../shaders/gpu/receivers.wgsl"), &[]);
-        let weber = crate::shader::module(&gpu.device, "weber", include_str!("../../../shaders/gpu/weber.wgsl"), &[]);
-        let gate = crate::shader::module(&gpu.device, "gate", include_str!("../../../shaders/gpu/gate.wgsl"), &[]);
+        let module = crate::shader::module(&gpu.device, "receivers", include_str!("../shaders/receivers.wgsl"), &[]);
+        let weber = crate::shader::module(&gpu.device, "weber", include_str!("../shaders/weber.wgsl"), &[]);
+        let gate = crate::shader::module(&gpu.device, "gate", include_str!("../shaders/gate.wgsl"), &[]);
         let pipeline_of = |module: &wgpu::ShaderModule, entry| {
             gpu.compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(entry),

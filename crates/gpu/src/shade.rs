@@ -192,7 +192,7 @@ impl ShadingPass {
     /// # Errors
     /// GPU failures.
     pub fn new(gpu: &Gpu) -> Result<Self, GpuError> {
-        let module = crate::shader::module(&gpu.device, "shade", include_str!("../../../shaders/gpu/shade.wgsl"), &[]);
+        let module = crate::shader::module(&gpu.device, "shade", include_str!("../shaders/shade.wgsl"), &[]);
         let pipeline = crate::fullscreen::pipeline(gpu, "shade", &module, HDR_FORMAT);
         let none = PrefilteredMap { levels: vec![EnvMap::constant(1, 1, Vec3::ZERO)] };
         let no_specular = SpecularAmbient::upload(gpu, &none, &DfgTable { size: 1, values: vec![[0.0; 2]] })?;

@@ -1,13 +1,13 @@
-//! WGSL sources and their composition. Shaders live in `shaders/<crate>/`; a file may start with
+//! WGSL sources and their composition. Shaders live in `crates/<crate>/shaders/`; a file may start with
 //! `// requires: <crate>/<file>.wgsl ...` lines naming library files (functions only) that are
 //! prepended, in order, before it is compiled. The workspace test that validates every shader
 //! with naga resolves the same lines.
 
 /// Library WGSL of this crate, by the name used in `// requires:` lines.
 pub const LIBRARY: &[(&str, &str)] = &[
-    ("gpu/brdf.wgsl", include_str!("../../../shaders/gpu/brdf.wgsl")),
-    ("gpu/sh9.wgsl", include_str!("../../../shaders/gpu/sh9.wgsl")),
-    ("gpu/fullscreen.wgsl", include_str!("../../../shaders/gpu/fullscreen.wgsl")),
+    ("gpu/brdf.wgsl", include_str!("../shaders/brdf.wgsl")),
+    ("gpu/sh9.wgsl", include_str!("../shaders/sh9.wgsl")),
+    ("gpu/fullscreen.wgsl", include_str!("../shaders/fullscreen.wgsl")),
 ];
 
 /// The names listed on `// requires:` lines at the top of `source`.
@@ -39,7 +39,7 @@ pub fn compose(source: &str, extra: &[(&str, &str)]) -> String {
 }
 
 /// `source` with the library files its `// requires:` lines name prepended, each fetched by
-/// `resolve` (from a table at run time, from `shaders/` in the workspace test); `enable`
+/// `resolve` (from a table at run time, from `crates/<crate>/shaders/` in the workspace test); `enable`
 /// directives stay first.
 ///
 /// # Errors

@@ -9,9 +9,7 @@ use crate::gbuffer::GBufferPass;
 use crate::geometry::SceneGeometry;
 use crate::lit_frame::FrameLights;
 use crate::shade::{ShadeParams, ShadingPass, Visibility};
-use crate::technique::{
-    Receivers, ShadowPassReport, ShadowTechnique, WEBER_FRACTION, record_visibility, weber_negligible,
-};
+use crate::technique::{Receivers, ShadowPassReport, ShadowTechnique, WEBER_FRACTION, weber_negligible};
 use crate::upsample::{JointBilateral, UpsamplePass};
 
 /// How the EnvIndirects are drawn.
@@ -117,49 +115,6 @@ pub(crate) fn indirect_size((w, h): (u32, u32), settings: &SplitSettings) -> Res
     Ok((w / f, h / f))
 }
 
-/// Renders a split frame over `receivers` (the full-resolution G-buffer and its points) and
-/// waits for it: the low-resolution G-buffer is rendered and read here, then
-/// [`record_split`] records the rest in one submission.
-///
-/// # Errors
-/// As [`record_split`]; GPU failures.
-pub fn render_split(
-    gpu: &Gpu,
-    passes: &SplitPasses,
-    geometry: &SceneGeometry,
-    (receivers, direct_visibility): (&Receivers, &Visibility),
-    frame: &SplitFrame,
-    indirect: &dyn ShadowTechnique,
-    settings: &SplitSettings,
-) -> Result<SplitImage, GpuError> {
-    let (lw, lh) = indirect_size(receivers.gbuffer.size(), settings)?;
-    let (low_gb, low_points, low_receivers);
-    let low = if settings.indirect_scale == 1 {
-        receivers
-    } else {
-        let mut encoder = gpu.encoder("low gbuffer");
-        low_gb = passes.gbuffer.record_view(gpu, &mut encoder, geometry, &receivers.gbuffer.view.resized(lw, lh))?;
-        gpu.submit(encoder);
-        low_points = low_gb.read_points(gpu)?;
-        low_receivers = Receivers::new(&low_gb, &low_points);
-        &low_receivers
-    };
-    let mut encoder = gpu.encoder("split frame");
-    let image = record_split(
-        gpu,
-        &mut encoder,
-        passes,
-        geometry,
-        (receivers, direct_visibility),
-        (low, None),
-        frame,
-        indirect,
-        settings,
-    )?;
-    gpu.submit_and_wait(encoder)?;
-    Ok(image)
-}
-
 /// Records a split frame into `encoder`, without submitting. The EnvDirects' visibility comes
 /// in `direct_visibility` (layer k for light k < `directs`, made by the caller with any
 /// technique); the EnvIndirects' is made here with `indirect` over `low` (the receivers of the
@@ -182,6 +137,36 @@ pub fn record_split(
     frame: &SplitFrame,
     indirect: &dyn ShadowTechnique,
     settings: &SplitSettings,
+) -> Result<SplitImage, GpuError> {
+    let visibility = (receivers, direct_visibility);
+    record_split_stamped(
+        gpu,
+        encoder,
+        passes,
+        geometry,
+        visibility,
+        (low, low_negligible),
+        frame,
+        indirect,
+        settings,
+        None,
+    )
+}
+
+/// [`record_split`] with EnvIndirect k timed between pair `directs + k` of `stamps`
+/// (measurement: [`LitSettings::time_lights`](crate::LitSettings::time_lights)).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn record_split_stamped(
+    gpu: &Gpu,
+    encoder: &mut wgpu::CommandEncoder,
+    passes: &SplitPasses,
+    geometry: &SceneGeometry,
+    (receivers, direct_visibility): (&Receivers, &Visibility),
+    (low, low_negligible): (&Receivers, Option<&[bool]>),
+    frame: &SplitFrame,
+    indirect: &dyn ShadowTechnique,
+    settings: &SplitSettings,
+    stamps: Option<&crate::technique::LightStamps>,
 ) -> Result<SplitImage, GpuError> {
     let gb = receivers.gbuffer;
     if low.gbuffer.size() != indirect_size(gb.size(), settings)? {
@@ -241,7 +226,14 @@ pub fn record_split(
     };
     let negligible =
         if negligible.len() >= frame.lit.directs { negligible.split_off(frame.lit.directs) } else { Vec::new() };
-    let indirect_reports = record_visibility(gpu, encoder, indirect, low, indirect_shapes, &negligible, visibility)?;
+    let indirect_reports = crate::technique::record_visibility_stamped(
+        gpu,
+        encoder,
+        (indirect, low),
+        (indirect_shapes, &negligible),
+        visibility,
+        stamps.map(|s| (s, frame.lit.directs)),
+    )?;
     passes.shading.record_into(
         gpu,
         encoder,

@@ -304,32 +304,33 @@ pub fn record_visibility(
     record_visibility_stamped(gpu, encoder, (technique, receivers), (lights, negligible), visibility, None)
 }
 
-/// [`record_visibility`] with light `k`'s passes between the k-th pair of `stamps`
-/// (measurement: [`LightStamps`]).
+/// [`record_visibility`] with light `k`'s passes between pair `first + k` of `stamps`
+/// (measurement: [`LightStamps`]; `first` places a split frame's EnvIndirects after its
+/// EnvDirects).
 pub(crate) fn record_visibility_stamped(
     gpu: &Gpu,
     encoder: &mut wgpu::CommandEncoder,
     (technique, receivers): (&dyn ShadowTechnique, &Receivers),
     (lights, negligible): (&[LightShape], &[bool]),
     visibility: &Visibility,
-    stamps: Option<&LightStamps>,
+    stamps: Option<(&LightStamps, usize)>,
 ) -> Result<Vec<ShadowPassReport>, GpuError> {
     let reports = each_light(receivers, lights, negligible, visibility, |k, light| {
         let gate = receivers.on_gpu.as_ref().map(|s| s.gate(k));
-        if let Some(s) = stamps {
-            s.write(encoder, k as usize, 0);
+        if let Some((s, first)) = stamps {
+            s.write(encoder, first + k as usize, 0);
         }
         let report = technique.record(gpu, encoder, receivers, light, gate, &visibility.layer(k));
-        if let Some(s) = stamps {
-            s.write(encoder, k as usize, 1);
+        if let Some((s, first)) = stamps {
+            s.write(encoder, first + k as usize, 1);
         }
         report
     })?;
     // skipped lights' pairs are written too (nothing between them), so that every query resolves
-    if let Some(s) = stamps {
+    if let Some((s, first)) = stamps {
         for (k, _) in reports.iter().enumerate().filter(|(_, r)| r.skipped.is_some()) {
-            s.write(encoder, k, 0);
-            s.write(encoder, k, 1);
+            s.write(encoder, first + k, 0);
+            s.write(encoder, first + k, 1);
         }
     }
     Ok(reports)
@@ -445,7 +446,7 @@ pub fn render_visibility(
         (technique, receivers),
         (lights, negligible),
         visibility,
-        stamps.as_ref(),
+        stamps.as_ref().map(|s| (s, 0)),
     )?;
     if let Some(s) = &stamps {
         s.record_resolve(&mut encoder);
@@ -613,8 +614,7 @@ impl PrecomputedVisibility {
                 limit: pixels,
             });
         }
-        let module =
-            crate::shader::module(&gpu.device, "upload", include_str!("../../../shaders/gpu/upload.wgsl"), &[]);
+        let module = crate::shader::module(&gpu.device, "upload", include_str!("../shaders/upload.wgsl"), &[]);
         let pipeline = crate::fullscreen::pipeline(gpu, "upload", &module, Visibility::FORMAT);
         let buffer = |label, contents: &[u8], usage| {
             gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })

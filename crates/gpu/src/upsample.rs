@@ -81,8 +81,7 @@ impl UpsamplePass {
     /// Builds the pipeline.
     #[must_use]
     pub fn new(gpu: &Gpu) -> Self {
-        let module =
-            crate::shader::module(&gpu.device, "upsample", include_str!("../../../shaders/gpu/upsample.wgsl"), &[]);
+        let module = crate::shader::module(&gpu.device, "upsample", include_str!("../shaders/upsample.wgsl"), &[]);
         Self {
             pipeline: crate::fullscreen::pipeline(gpu, "upsample", &module, crate::shade::HDR_FORMAT),
             slots: crate::Slots::new(),

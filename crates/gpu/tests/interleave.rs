@@ -33,6 +33,9 @@ fn gathering_takes_each_pixel_from_its_set() {
     let colour = |s: u32| Vec3::new(s as f32, 1.0 + s as f32 * 0.5, -(s as f32));
     let dst = render_target(&gpu, "gathered", (w, h, 1), HDR_FORMAT).unwrap();
     let pass = InterleavePass::new(&gpu);
+    // every set's gathering in one submission: each keeps its own parameters
+    let mut encoder = gpu.encoder("gather");
+    let mut sources = Vec::new();
     for s in 0..sets {
         let texels: Vec<[f32; 4]> = vec![colour(s).extend(1.0).to_array(); (w * h) as usize];
         let src = gpu.device.create_texture_with_data(
@@ -50,9 +53,11 @@ fn gathering_takes_each_pixel_from_its_set() {
             wgpu::util::TextureDataOrder::LayerMajor,
             bytemuck::cast_slice(&texels),
         );
-        pass.gather(&gpu, &src, &dst, sets, s).unwrap();
-        assert!(pass.gather(&gpu, &src, &dst, sets, sets).is_err());
+        pass.record_gather(&gpu, &mut encoder, (&src, &dst), sets, s).unwrap();
+        assert!(pass.record_gather(&gpu, &mut encoder, (&src, &dst), sets, sets).is_err());
+        sources.push(src);
     }
+    gpu.submit(encoder);
     let image = read_hdr(&gpu, &dst).unwrap();
     for y in 0..h {
         for x in 0..w {

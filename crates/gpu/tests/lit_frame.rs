@@ -140,3 +140,66 @@ fn misused_frames_are_errors() {
     let small = view.resized(24, 18);
     assert!(lit.render(&gpu, &geometry, &small, &all, None, &settings).is_err());
 }
+
+#[test]
+fn interleaved_sets_take_each_pixel_from_their_own_frame() {
+    let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
+    let s = scene();
+    let size = (s.camera.width, s.camera.height);
+    let geometry = SceneGeometry::upload(&gpu, &s).unwrap();
+    let view = GBufferPass::camera_view(&geometry, &s.camera);
+    let base = lights();
+    let shapes: Vec<LightShape> = base.iter().map(shape).collect();
+    let pixels = (size.0 * size.1) as usize;
+    let layers = shapes.iter().enumerate().map(|(k, l)| (*l, vec![0.3 + 0.2 * k as f32; pixels])).collect();
+    let technique = PrecomputedVisibility::new(&gpu, "graded", size, layers).unwrap();
+    let shadows = FrameShadows { direct: &technique, indirect: &technique };
+    // three sets of the same shapes in other colours: each pixel tells its set apart
+    let sets: Vec<Vec<ShadeLight>> = (0..3)
+        .map(|k| {
+            let tint = [Vec3::new(1.0, 0.2, 0.2), Vec3::new(0.2, 1.0, 0.2), Vec3::new(0.2, 0.2, 1.0)][k];
+            base.iter()
+                .map(|l| match *l {
+                    ShadeLight::Distant { direction, irradiance, half_angle } => {
+                        ShadeLight::Distant { direction, irradiance: irradiance * tint, half_angle }
+                    }
+                    other => other,
+                })
+                .collect()
+        })
+        .collect();
+    let frames: Vec<FrameLights> = sets.iter().map(|l| every_light_direct(l, &shapes)).collect();
+    let lit = LitFrame::new(&gpu, size).unwrap();
+    let settings = LitSettings { weber: false, ..LitSettings::default() };
+    // each set alone, read back before the next overwrites the frame's target
+    let alone: Vec<Vec<Vec3>> = frames
+        .iter()
+        .map(|f| {
+            let frame = lit.render(&gpu, &geometry, &view, f, Some(shadows), &settings).unwrap();
+            gpu.wait(None).unwrap();
+            read_hdr(&gpu, &frame.finish_reports(&gpu).unwrap().0).unwrap()
+        })
+        .collect();
+    assert_ne!(alone[0], alone[1]);
+    for reference in [None, Some(ReferenceReceivers::CpuPoints)] {
+        let before = gpu.counters();
+        let image = lit.render_interleaved(&gpu, &geometry, &view, &frames, shadows, &settings, reference).unwrap();
+        let d = gpu.counters() - before;
+        if reference.is_none() {
+            // each set's two submissions and its gathering; no wait
+            assert_eq!((d.submits, d.waits), (3 * 3, 0), "{d:?}");
+        }
+        gpu.wait(None).unwrap();
+        let (texture, reports) = image.finish_reports(&gpu).unwrap();
+        assert_eq!(reports.len(), 3 * base.len());
+        let got = read_hdr(&gpu, &texture).unwrap();
+        for y in 0..size.1 {
+            for x in 0..size.0 {
+                let k = (y * size.0 + x) as usize;
+                let set = gpu::interleave_set(x, y, 3) as usize;
+                assert_eq!(got[k], alone[set][k], "pixel ({x}, {y}), {reference:?}");
+            }
+        }
+    }
+    assert!(lit.render_interleaved(&gpu, &geometry, &view, &[], shadows, &settings, None).is_err());
+}

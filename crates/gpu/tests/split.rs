@@ -1,14 +1,14 @@
 //! Paper 001's split frame: EnvDirects at full resolution, EnvIndirects at a reduced one with
-//! joint bilateral upsampling. Checked against the same lights shaded at full resolution in one
+//! joint bilateral upsampling, drawn through the recorded frame (`gpu::LitFrame`). Checked against the same lights shaded at full resolution in one
 //! pass: exactly at scale 1, within stated bounds away from edges otherwise, with no halo past a
 //! stated width, and finite everywhere on an object one pixel wide.
 
 use envmap_sphere::Sh9;
 use glam::Vec3;
 use gpu::{
-    GBufferPass, Gpu, GpuError, JointBilateral, LightShape, Receivers, SceneGeometry, ShadeLight, ShadeParams,
-    ShadingPass, ShadowPassReport, ShadowTechnique, SplitFrame, SplitPasses, SplitSettings, UpsamplePass, Visibility,
-    read_hdr, render_split,
+    FrameLights, FrameShadows, GBufferPass, Gpu, GpuError, JointBilateral, LightShape, LitFrame, LitSettings,
+    Receivers, ReferenceReceivers, SceneGeometry, ShadeLight, ShadowPassReport, ShadowTechnique, SplitSettings,
+    read_hdr,
 };
 use scene::{Camera, DistantLight, Material, Mesh, Object, Scene};
 
@@ -130,6 +130,20 @@ fn frame() -> Frame {
     Frame { lights: all.iter().map(|l| l.0).collect(), shapes: all.iter().map(|l| l.1).collect(), directs: 1, ambient }
 }
 
+impl Frame {
+    /// The frame's lights as the recorded frame takes them, split at `directs`.
+    fn lights(&self) -> FrameLights<'_> {
+        FrameLights {
+            lights: &self.lights,
+            shapes: &self.shapes,
+            directs: self.directs,
+            ambient: Some(&self.ambient),
+            specular_ambient: None,
+            background: None,
+        }
+    }
+}
+
 struct Rendered {
     split: Vec<Vec3>,
     whole: Vec<Vec3>,
@@ -144,43 +158,24 @@ fn render_with(scene: &Scene, settings: &SplitSettings, technique: &dyn ShadowTe
     let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
     let f = frame();
     let geometry = SceneGeometry::upload(&gpu, scene)?;
-    let gbuffer = GBufferPass::new(&gpu);
-    let shading = ShadingPass::new(&gpu)?;
-    let upsample = UpsamplePass::new(&gpu);
-    let gb = gbuffer.render(&gpu, &geometry, &scene.camera)?;
-    let points = gb.read_points(&gpu)?;
-    let receivers = Receivers::new(&gb, &points);
-    let (w, h) = gb.size();
-    let lit = Visibility::new(&gpu, w, h, f.lights.len() as u32)?;
-    gpu::render_visibility(&gpu, technique, &receivers, &f.shapes, &[], &lit)?;
-    let split = render_split(
-        &gpu,
-        &SplitPasses { gbuffer: &gbuffer, shading: &shading, upsample: &upsample },
-        &geometry,
-        (&receivers, &lit),
-        &SplitFrame {
-            lit: gpu::FrameLights {
-                lights: &f.lights,
-                shapes: &f.shapes,
-                directs: f.directs,
-                ambient: Some(&f.ambient),
-                specular_ambient: None,
-                background: None,
-            },
-            targets: None,
-        },
-        technique,
-        settings,
-    )?;
-    let whole = shading.render(
-        &gpu,
-        &geometry,
-        &gb,
-        &ShadeParams { lights: &f.lights, ambient: Some(&f.ambient), ..Default::default() },
-        &lit,
-    )?;
+    let lit = LitFrame::new(&gpu, (scene.camera.width, scene.camera.height))?;
+    let view = GBufferPass::camera_view(&geometry, &scene.camera);
+    let split_lights = f.lights();
+    // every light shadowed: the split and the whole frame differ only by resolution
+    let settings = LitSettings { split: *settings, weber: false, time_lights: false };
+    let shadows = FrameShadows { direct: technique, indirect: technique };
+    // the stand-in techniques compute their values from the receivers' points
+    let image = |lights: &FrameLights| -> Result<Vec<Vec3>, GpuError> {
+        let frame =
+            lit.render_reference(&gpu, &geometry, &view, lights, shadows, &settings, ReferenceReceivers::CpuPoints)?;
+        gpu.wait(None)?;
+        read_hdr(&gpu, &frame.finish_reports(&gpu)?.0)
+    };
+    let split = image(&split_lights)?;
+    let whole = image(&FrameLights { directs: f.lights.len(), ..split_lights })?;
+    let gb = GBufferPass::new(&gpu).render(&gpu, &geometry, &scene.camera)?;
     let ids = gb.read_positions(&gpu)?.iter().map(|p| p[3]).collect();
-    Ok(Rendered { split: read_hdr(&gpu, &split.texture)?, whole, ids })
+    Ok(Rendered { split, whole, ids })
 }
 
 /// Per pixel, the distance in pixels (Chebyshev) to the nearest pixel of another object.
@@ -296,4 +291,36 @@ fn sizes_and_sigmas_out_of_range_are_errors() {
     assert!(render(&scene, &SplitSettings { indirect_scale: 2, upsample: bad }).is_err());
     let wide = JointBilateral { radius: 100, ..JointBilateral::PAPER };
     assert!(render(&scene, &SplitSettings { indirect_scale: 2, upsample: wide }).is_err());
+}
+
+#[test]
+fn a_timed_split_frame_times_its_envindirects_too() {
+    // Measurement wraps the recorded frame: with `time_lights` each drawn light, EnvDirect or
+    // EnvIndirect, carries its own timestamps (on a device that has them inside encoders)
+    let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
+    let scene = stage(64, 48);
+    let f = frame();
+    let geometry = SceneGeometry::upload(&gpu, &scene).unwrap();
+    let lit = LitFrame::new(&gpu, (64, 48)).unwrap();
+    let view = GBufferPass::camera_view(&geometry, &scene.camera);
+    let lights = f.lights();
+    let settings = LitSettings {
+        split: SplitSettings { indirect_scale: 2, ..SplitSettings::default() },
+        weber: false,
+        time_lights: true,
+    };
+    let shadows = FrameShadows { direct: &Unshadowed, indirect: &Unshadowed };
+    let frame = lit
+        .render_reference(&gpu, &geometry, &view, &lights, shadows, &settings, ReferenceReceivers::CpuPoints)
+        .unwrap();
+    gpu.wait(None).unwrap();
+    let (_, reports) = frame.finish_reports(&gpu).unwrap();
+    assert_eq!(reports.len(), f.lights.len());
+    let stamped =
+        gpu.features.contains(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS);
+    for (k, r) in reports.iter().enumerate() {
+        assert!(r.skipped.is_none(), "light {k} skipped: {r:?}");
+        let want = stamped.then_some(gpu::Clock::GpuTimestamps);
+        assert_eq!(r.clock, want, "light {k} ({}): {r:?}", if k < f.directs { "EnvDirect" } else { "EnvIndirect" });
+    }
 }

@@ -61,6 +61,12 @@ pub use residual::{Residual, splat_lights};
 pub use variance::VarianceMinimization;
 pub use weber::{COVERED_SHARE, CompactSource, Weber, compact_sources};
 
+/// The toolkit's default extraction, the most accurate in `eval-lights` (the README's
+/// extraction section has its error against median cut's): paper 001's emissive split with our
+/// options. `validate`, the
+/// trade, the benches and the examples all draw it from here.
+pub const DEFAULT_METHOD: &str = "emissive-split+moment-cones+above-horizon+residual";
+
 /// The methods by name, as `lights.json` and the commands name them.
 pub const METHODS: [&str; 5] = ["emissive-split", "center-surround", "median-cut", "variance-min", "importance"];
 

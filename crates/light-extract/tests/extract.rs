@@ -11,7 +11,7 @@ use std::f64::consts::{PI, TAU};
 use std::path::PathBuf;
 
 fn shared_maps() -> Vec<PathBuf> {
-    envmap_sphere::test_set::maps().unwrap_or_else(|e| panic!("{e}"))
+    test_set::maps().unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn methods(k: usize) -> Vec<Box<dyn LightExtractor>> {

@@ -1,4 +1,4 @@
-//! The wedge term on the CPU, as `shaders/penumbra-wedge/wedge.wgsl` computes it per pixel, and
+//! The wedge term on the CPU, as `crates/penumbra-wedge/shaders/wedge.wgsl` computes it per pixel, and
 //! the closed forms it is tested against.
 //!
 //! In a frame at the receiver `p` whose z axis points at the light's centre, an edge's clipped
@@ -643,7 +643,7 @@ mod tests {
 
     #[test]
     fn shader_moves_receivers_off_planes_as_the_cpu_does() {
-        let wgsl = include_str!("../../../shaders/penumbra-wedge/coverage.wgsl");
+        let wgsl = include_str!("../shaders/coverage.wgsl");
         assert!(wgsl.contains(&format!("const ON_PLANE: f32 = {ON_PLANE:e};")), "coverage.wgsl's ON_PLANE differs");
     }
 

@@ -1,4 +1,4 @@
-//! The wedges' geometry built on the GPU for every light (`shaders/penumbra-wedge/build.wgsl`):
+//! The wedges' geometry built on the GPU for every light (`crates/penumbra-wedge/shaders/build.wgsl`):
 //! the casters' welded faces and their edges with adjacency live in buffers made once per scene;
 //! per light, five compute dispatches classify the faces, count each edge's lit faces, compact
 //! the silhouette in edge order, append the hard volume and bound each wedge's footprint. The
@@ -276,12 +276,7 @@ pub(crate) struct LightBuild<'a> {
 
 impl GpuBuilder {
     pub(crate) fn new(gpu: &Gpu, casters: &Casters, edges_per_footprint: u32, library: &[(&str, &str)]) -> Self {
-        let module = gpu::shader::module(
-            &gpu.device,
-            "wedge build",
-            include_str!("../../../shaders/penumbra-wedge/build.wgsl"),
-            library,
-        );
+        let module = gpu::shader::module(&gpu.device, "wedge build", include_str!("../shaders/build.wgsl"), library);
         let pipeline = |entry: &str| {
             gpu.compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(entry),

@@ -45,7 +45,7 @@ pub enum WedgePath {
     #[default]
     Raster,
     /// Footprints binned into 16 × 16 screen tiles on the CPU, every pixel of a tile summing
-    /// its tile's edges in one compute invocation (`shaders/penumbra-wedge/tiles.wgsl`): no
+    /// its tile's edges in one compute invocation (`crates/penumbra-wedge/shaders/tiles.wgsl`): no
     /// blending, one write per pixel, more edge terms evaluated (the whole tile's).
     Compute,
 }
@@ -53,7 +53,7 @@ pub enum WedgePath {
 /// Where a light's silhouette, volume and footprints are built.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum WedgeBuild {
-    /// On the GPU, in compute passes recorded with the light (`shaders/penumbra-wedge/build.wgsl`):
+    /// On the GPU, in compute passes recorded with the light (`crates/penumbra-wedge/shaders/build.wgsl`):
     /// the CPU never sees the silhouette. A footprint (an octagon around the wedges) covers
     /// [`WedgeSettings::edges_per_footprint`] consecutive silhouette edges in the casters' edge
     /// order (along a Hilbert curve) rather than along a chain. The raster path only: the
@@ -211,9 +211,9 @@ struct Scratch {
 
 /// The WGSL library of this crate's shaders (`// requires:` names).
 const LIBRARY: &[(&str, &str)] = &[
-    ("penumbra-wedge/light.wgsl", include_str!("../../../shaders/penumbra-wedge/light.wgsl")),
-    ("penumbra-wedge/coverage.wgsl", include_str!("../../../shaders/penumbra-wedge/coverage.wgsl")),
-    ("penumbra-wedge/footprint.wgsl", include_str!("../../../shaders/penumbra-wedge/footprint.wgsl")),
+    ("penumbra-wedge/light.wgsl", include_str!("../shaders/light.wgsl")),
+    ("penumbra-wedge/coverage.wgsl", include_str!("../shaders/coverage.wgsl")),
+    ("penumbra-wedge/footprint.wgsl", include_str!("../shaders/footprint.wgsl")),
 ];
 
 #[repr(C)]
@@ -313,8 +313,8 @@ impl Wedges {
         let casters = Casters::new(scene);
         let (lo, hi) = casters_bounds(&casters);
         let module = |label, src| gpu::shader::module(&gpu.device, label, src, LIBRARY);
-        let volume_module = module("shadow volume", include_str!("../../../shaders/penumbra-wedge/volume.wgsl"));
-        let wedge_module = module("wedges", include_str!("../../../shaders/penumbra-wedge/wedge.wgsl"));
+        let volume_module = module("shadow volume", include_str!("../shaders/volume.wgsl"));
+        let wedge_module = module("wedges", include_str!("../shaders/wedge.wgsl"));
         let pipeline = |label, m: &wgpu::ShaderModule, entry: &str, layout: Option<wgpu::VertexBufferLayout<'_>>| {
             gpu.render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(label),
@@ -360,13 +360,8 @@ impl Wedges {
             }),
         );
         let polygons = pipeline("wedges built on the GPU", &wedge_module, "vs_polygon", None);
-        let resolve = ResolvePass::with_shader(
-            gpu,
-            "wedge resolve",
-            include_str!("../../../shaders/penumbra-wedge/resolve.wgsl"),
-            LIBRARY,
-        );
-        let tiles_module = module("wedge tiles", include_str!("../../../shaders/penumbra-wedge/tiles.wgsl"));
+        let resolve = ResolvePass::with_shader(gpu, "wedge resolve", include_str!("../shaders/resolve.wgsl"), LIBRARY);
+        let tiles_module = module("wedge tiles", include_str!("../shaders/tiles.wgsl"));
         let tiles = gpu.compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some("wedge tiles"),
             layout: None,

@@ -49,7 +49,7 @@ impl DistantLight {
     /// The integral of cos over the part of the cone above a surface whose normal is at
     /// `cos_theta` from the cone's axis: the irradiance per unit radiance it gives (π sin²α cos θ
     /// while the cone is wholly above the horizon; Snyder's closed form for a uniform sphere or
-    /// disk light across it). The GPU shading pass evaluates the same (`shaders/gpu/shade.wgsl`).
+    /// disk light across it). The GPU shading pass evaluates the same (`crates/gpu/shaders/shade.wgsl`).
     #[must_use]
     pub fn cosine_integral(&self, cos_theta: f32) -> f32 {
         cone_cosine_integral(cos_theta, self.half_angle().min(std::f32::consts::FRAC_PI_2))

@@ -18,9 +18,6 @@ use std::error::Error;
 use std::path::{Path, PathBuf};
 use wgpu::util::DeviceExt;
 
-/// The extraction: the toolkit's most accurate.
-const METHOD: &str = "emissive-split+moment-cones+above-horizon+residual";
-
 /// The renderer's vertex: position, shading normal (zero: flat), object.
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -162,7 +159,7 @@ pub fn run(map: Option<&Path>, out: &Path, frames: usize, (w, h): (u32, u32)) ->
         Some(p) => envmap_sphere::EnvMap::load(p)?,
         None => envmap_sphere::default_map(),
     };
-    let extractor = light_extract::extractor(METHOD, 8).ok_or("unknown method")?;
+    let extractor = light_extract::extractor(light_extract::DEFAULT_METHOD, 8).ok_or("unknown method")?;
     let decomposition = extractor.extract(&map)?;
     let mut shapes: Vec<LightShape> = decomposition.lights.iter().map(|l| LightShape::from(&l.light)).collect();
     let mut shade: Vec<ShadeLight> = decomposition.lights.iter().map(|l| ShadeLight::from(&l.light)).collect();

@@ -10,8 +10,8 @@ use std::time::Duration;
 /// This crate's WGSL library files (for `// requires:` lines; shaders that read its maps use
 /// `lookup.wgsl`).
 pub const LIBRARY: &[(&str, &str)] = &[
-    ("shadowmap-paraboloid/paraboloid.wgsl", include_str!("../../../shaders/shadowmap-paraboloid/paraboloid.wgsl")),
-    ("shadowmap-paraboloid/lookup.wgsl", include_str!("../../../shaders/shadowmap-paraboloid/lookup.wgsl")),
+    ("shadowmap-paraboloid/paraboloid.wgsl", include_str!("../shaders/paraboloid.wgsl")),
+    ("shadowmap-paraboloid/lookup.wgsl", include_str!("../shaders/lookup.wgsl")),
 ];
 
 /// Depth format of every shadow map: 32-bit float, readable back.
@@ -158,7 +158,7 @@ impl ShadowMap {
     }
 }
 
-/// A map as `shaders/shadowmap-paraboloid/lookup.wgsl` reads it (`MapParams`).
+/// A map as `crates/shadowmap-paraboloid/shaders/lookup.wgsl` reads it (`MapParams`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct MapParams {
@@ -388,10 +388,10 @@ impl ShadowMapper {
     #[must_use]
     pub fn new(gpu: &Gpu) -> Self {
         let src = |name| match name {
-            "clip" => include_str!("../../../shaders/shadowmap-paraboloid/paraboloid_depth.wgsl"),
-            "discard" => include_str!("../../../shaders/shadowmap-paraboloid/paraboloid_depth_discard.wgsl"),
-            "matrix" => include_str!("../../../shaders/shadowmap-paraboloid/matrix_depth.wgsl"),
-            _ => include_str!("../../../shaders/shadowmap-paraboloid/visibility.wgsl"),
+            "clip" => include_str!("../shaders/paraboloid_depth.wgsl"),
+            "discard" => include_str!("../shaders/paraboloid_depth_discard.wgsl"),
+            "matrix" => include_str!("../shaders/matrix_depth.wgsl"),
+            _ => include_str!("../shaders/visibility.wgsl"),
         };
         let module = gpu::shader::module(&gpu.device, "shadow visibility", src("visibility"), LIBRARY);
         let visibility = gpu::fullscreen::pipeline(gpu, "shadow visibility", &module, gpu::Visibility::FORMAT);
@@ -419,12 +419,8 @@ impl ShadowMapper {
             bind_group_layouts: &[Some(&view_layout)],
             immediate_size: 0,
         });
-        let focus_module = gpu::shader::module(
-            &gpu.device,
-            "orthographic focus",
-            include_str!("../../../shaders/shadowmap-paraboloid/ortho_focus.wgsl"),
-            &[],
-        );
+        let focus_module =
+            gpu::shader::module(&gpu.device, "orthographic focus", include_str!("../shaders/ortho_focus.wgsl"), &[]);
         let focus = gpu.compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some("orthographic focus"),
             layout: None,

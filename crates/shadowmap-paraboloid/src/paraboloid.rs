@@ -5,7 +5,7 @@
 //! distance to the light between a near and a far sphere, mapped to [0, 1].
 //!
 //! The back map of a dual paraboloid uses the frame turned 180° about its y axis, (x, y, z) ->
-//! (-x, y, -z). The GPU shaders (`shaders/shadowmap-paraboloid/paraboloid.wgsl`) do the same
+//! (-x, y, -z). The GPU shaders (`crates/shadowmap-paraboloid/shaders/paraboloid.wgsl`) do the same
 //! arithmetic; tests compare both.
 
 use glam::{Mat4, Vec2, Vec3};

@@ -15,8 +15,8 @@ use crate::setting::Shadow;
 use envmap_sphere::EnvMap;
 use glam::{DVec3, Vec3};
 use gpu::{
-    Gpu, InterleavedFrame, Receivers, RotatedGrid, SceneGeometry, ShadeLight, ShadeParams, Visibility, WEBER_FRACTION,
-    render_interleaved,
+    FrameLights, FrameShadows, GBufferPass, Gpu, LightShape, LitSettings, RotatedGrid, SceneGeometry, ShadeLight,
+    WEBER_FRACTION,
 };
 use light_extract::Decomposition;
 use rayon::prelude::*;
@@ -291,29 +291,38 @@ pub fn measure_banding(
             .into_iter()
             .map(|set| set.iter().map(|l| l.light).collect())
             .collect();
+    // the toolkit's recorded frame, every light of every set shadowed (no Weber skipping)
+    let lit = passes.lit_frame(gpu, (scene.camera.width, scene.camera.height))?;
+    let view = GBufferPass::camera_view(&geometry, &scene.camera);
+    let shade: Vec<Vec<ShadeLight>> = light_sets.iter().map(|s| s.iter().map(ShadeLight::from).collect()).collect();
+    let shapes: Vec<Vec<LightShape>> = light_sets.iter().map(|s| s.iter().map(LightShape::from).collect()).collect();
+    let frames: Vec<FrameLights> = shade
+        .iter()
+        .zip(&shapes)
+        .map(|(lights, shapes)| FrameLights {
+            lights,
+            shapes,
+            directs: lights.len(),
+            ambient: Some(&decomposition.ambient_sh),
+            // the camera sees only ground where it measures
+            specular_ambient: None,
+            background: None,
+        })
+        .collect();
+    let settings = LitSettings { weber: false, time_lights: true, ..LitSettings::default() };
     let t = Instant::now();
-    let gb = passes.gbuffer.render(gpu, &geometry, &scene.camera)?;
-    let (w, h) = gb.size();
-    let points = gb.read_points(gpu)?;
-    let receivers = Receivers::new(&gb, &points);
-    let lights: Vec<ShadeLight> = light_sets[0].iter().map(ShadeLight::from).collect();
-    let params = ShadeParams {
-        lights: &lights,
-        ambient: Some(&decomposition.ambient_sh),
-        // the camera sees only ground where it measures
-        background: None,
-        specular_ambient: None,
-    };
     let (texture, reports) = match technique.as_deref() {
         None => {
-            let vis = Visibility::new(gpu, w, h, lights.len().max(1) as u32)?;
-            (passes.shading.render_texture(gpu, &geometry, &gb, &params, &vis)?, Vec::new())
+            let frame = lit.render(gpu, &geometry, &view, &frames[0], None, &settings)?;
+            gpu.wait(None)?;
+            frame.finish_reports(gpu)?
         }
         // one set too: its gathering is a copy, and every row takes the same path
         Some(technique) => {
-            let frame =
-                InterleavedFrame { geometry: &geometry, receivers: &receivers, params: &params, negligible: &[] };
-            render_interleaved(gpu, &passes.shading, &frame, technique, &light_sets)?
+            let shadows = FrameShadows { direct: technique, indirect: technique };
+            let image = lit.render_interleaved(gpu, &geometry, &view, &frames, shadows, &settings, None)?;
+            gpu.wait(None)?;
+            image.finish_reports(gpu)?
         }
     };
     let image = gpu::read_hdr(gpu, &texture)?;

@@ -32,9 +32,7 @@ pub use composite::{CompositeCase, measure_composite};
 pub use front::{ChooseError, Measurement, Point, choose, front as pareto_front, mark_fronts, overall, pareto};
 pub use measure::{Case, Passes, Plan, measure};
 pub use point::{PointCase, measure_point};
-pub use setting::{
-    BEST_METHOD, CompositeSetting, EnvSetting, Family, PatchMaps, PointSetting, Preset, Setting, Shadow,
-};
+pub use setting::{CompositeSetting, EnvSetting, Family, PatchMaps, PointSetting, Preset, Setting, Shadow};
 pub use shard::{Shard, ShardError};
 pub use table::{Run, RunConfig, merge};
 

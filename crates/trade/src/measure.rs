@@ -9,16 +9,18 @@ use crate::setting::{EnvSetting, Setting, Shadow};
 use envmap_sphere::EnvMap;
 use glam::Vec3;
 use gpu::{
-    Background, FrameLights, FrameShadows, GBufferPass, Gpu, JointBilateral, LightShape, LitFrame, LitSettings,
-    PrefilterSettings, RotatedGrid, SceneGeometry, ShadeLight, ShadingPass, ShadowPassReport, ShadowTechnique,
-    SpecularAmbient, SplitSettings,
+    Background, FrameLights, FrameShadows, GBufferPass, Gpu, JointBilateral, Keyed, LightShape, LitFrame, LitSettings,
+    PrefilterSettings, RotatedGrid, SceneGeometry, ShadeLight, ShadowPassReport, ShadowTechnique, SpecularAmbient,
+    SplitSettings,
 };
 use light_extract::Decomposition;
 use penumbra_wedge::{WedgeSettings, Wedges};
 use ref_tracer::metrics::{FlipTonemap, flip, rmse};
 use ref_tracer::{EnvLight, Integrator, RenderSettings, SceneBvh, Strategy};
 use shadowmap_paraboloid::MapTechnique;
+use std::cell::RefCell;
 use std::collections::HashMap;
+use std::rc::Rc;
 use std::time::Instant;
 
 /// How a run measures.
@@ -89,10 +91,11 @@ impl Case {
     }
 }
 
-/// GPU passes built once and shared by every setting.
+/// GPU passes built once and shared by every setting: the truths' G-buffer pass and the
+/// recorded frame of the last size asked for.
 pub struct Passes {
     pub(crate) gbuffer: GBufferPass,
-    pub(crate) shading: ShadingPass,
+    lit: RefCell<Keyed<(u32, u32), Rc<LitFrame>>>,
 }
 
 impl Passes {
@@ -101,7 +104,13 @@ impl Passes {
     /// # Errors
     /// GPU failures.
     pub fn new(gpu: &Gpu) -> Result<Self, TradeError> {
-        Ok(Self { gbuffer: GBufferPass::new(gpu), shading: ShadingPass::new(gpu)? })
+        Ok(Self { gbuffer: GBufferPass::new(gpu), lit: RefCell::default() })
+    }
+
+    /// The recorded frame for frames of `size` pixels, made when the size differs from the
+    /// last one's.
+    pub(crate) fn lit_frame(&self, gpu: &Gpu, size: (u32, u32)) -> Result<Rc<LitFrame>, TradeError> {
+        Ok(self.lit.borrow_mut().try_get(size, || LitFrame::new(gpu, size).map(Rc::new))?.clone())
     }
 }
 

@@ -176,7 +176,7 @@ fn short_number(x: f64) -> String {
 
 /// A setting's name for a plot label: the best method's name left out (the report says so).
 fn label(setting: &str) -> String {
-    setting.strip_prefix(&format!("{}/", crate::BEST_METHOD)).unwrap_or(setting).to_string()
+    setting.strip_prefix(&format!("{}/", light_extract::DEFAULT_METHOD)).unwrap_or(setting).to_string()
 }
 
 fn escape(s: &str) -> String {
@@ -221,7 +221,7 @@ pub fn html(run: &Run, budgets: &[f64]) -> Result<String, TradeError> {
         escape(&c.adapter),
         escape(&c.preset),
         escape(&run.shards.join(", ")),
-        crate::BEST_METHOD
+        light_extract::DEFAULT_METHOD
     );
     let families: Vec<Family> = Family::ALL.into_iter().filter(|f| run.rows.iter().any(|r| r.family() == *f)).collect();
     for f in &families {

@@ -329,9 +329,6 @@ impl CompositeSetting {
     }
 }
 
-/// The toolkit's most accurate extraction (`validate`'s default).
-pub const BEST_METHOD: &str = "emissive-split+moment-cones+above-horizon+residual";
-
 /// Named sweeps.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Preset {
@@ -352,7 +349,7 @@ impl Preset {
     /// for reading).
     #[must_use]
     pub fn settings(self) -> Vec<Setting> {
-        let m = BEST_METHOD;
+        let m = light_extract::DEFAULT_METHOD;
         let env = |k, shadow| Setting::new(m, k, shadow);
         let point = |shadow| Setting::Point(PointSetting { shadow });
         let paraboloid = |resolution, pcf, subdivide| point(Shadow::Paraboloid { resolution, pcf, subdivide });

@@ -24,7 +24,7 @@ fn cap_map() -> EnvMap {
 }
 
 fn case_of(map: &EnvMap, k: usize, size: (u32, u32)) -> BandingCase {
-    let d = light_extract::extractor(trade::BEST_METHOD, k).expect("method").extract(map).expect("lights");
+    let d = light_extract::extractor(light_extract::DEFAULT_METHOD, k).expect("method").extract(map).expect("lights");
     BandingCase::new(map, &d, size).expect("a light above the horizon")
 }
 
@@ -90,12 +90,13 @@ fn black_and_below_horizon_maps_refuse_with_a_reason() {
     let black = EnvMap::constant(64, 32, Vec3::ZERO);
     let below = EnvMap::from_fn(64, 32, |d| if d.y < -0.2 { Vec3::splat(65504.0) } else { Vec3::ZERO });
     for map in [black, below] {
-        let d = light_extract::extractor(trade::BEST_METHOD, 4).expect("method").extract(&map).expect("lights");
+        let d =
+            light_extract::extractor(light_extract::DEFAULT_METHOD, 4).expect("method").extract(&map).expect("lights");
         let e = BandingCase::new(&map, &d, (32, 8)).err().expect("no light above the horizon");
         assert!(e.to_string().contains("above"), "{e}");
     }
     let cap = cap_map();
-    let d = light_extract::extractor(trade::BEST_METHOD, 4).expect("method").extract(&cap).expect("lights");
+    let d = light_extract::extractor(light_extract::DEFAULT_METHOD, 4).expect("method").extract(&cap).expect("lights");
     assert!(BandingCase::new(&cap, &d, (4, 1)).is_err(), "too small an image");
     assert!(BandingCase::new(&cap, &d, (16, 2)).is_ok());
 }

@@ -11,7 +11,7 @@ fn point(name: &str, ms: f64, rmse: f64) -> Point {
 }
 
 fn row(shadow: Shadow, k: usize, scene: &str, map: &str, ms: f64, rmse: f64) -> Measurement {
-    row_of(Setting::new(trade::BEST_METHOD, k, shadow), scene, map, ms, rmse)
+    row_of(Setting::new(light_extract::DEFAULT_METHOD, k, shadow), scene, map, ms, rmse)
 }
 
 fn row_of(knobs: Setting, scene: &str, map: &str, ms: f64, rmse: f64) -> Measurement {
@@ -265,7 +265,11 @@ fn families_keep_their_own_fronts_choices_and_report_sections() {
     assert_eq!(env.len(), 3, "{env:?}");
     assert_eq!(
         choose(&env, 0.3),
-        Err(ChooseError::OverBudget { budget: 0.3, cheapest: format!("{}/K8/none", trade::BEST_METHOD), ms: 0.5 })
+        Err(ChooseError::OverBudget {
+            budget: 0.3,
+            cheapest: format!("{}/K8/none", light_extract::DEFAULT_METHOD),
+            ms: 0.5
+        })
     );
     let points = overall(&run.rows, Family::Point);
     assert_eq!(trade::pareto_front(&points).len(), 1, "the paraboloid is faster and better: {points:?}");

@@ -11,7 +11,7 @@ use trade::{
 const PLAN: Plan = Plan { size: (64, 48), truth_spp: 32, repeats: 1, supersample: 1, photo_spp: 4 };
 
 fn settings() -> Vec<Setting> {
-    let m = trade::BEST_METHOD;
+    let m = light_extract::DEFAULT_METHOD;
     vec![
         Setting::new(m, 4, Shadow::None),
         Setting::new(m, 4, Shadow::Maps { resolution: 256, pcf: 1 }),
@@ -94,7 +94,7 @@ fn point_maps_are_measured_against_ray_traced_visibility() {
         point(Shadow::Paraboloid { resolution: 1024, pcf: 0, subdivide: false }),
         point(Shadow::Cube { resolution: 592, pcf: 0 }),
         // other families' settings are left to their own cases
-        Setting::new(trade::BEST_METHOD, 4, Shadow::Wedges),
+        Setting::new(light_extract::DEFAULT_METHOD, 4, Shadow::Wedges),
     ];
     let rows = measure_point(&gpu, &case, &settings, &plan, &mut |_| {}).expect("measured");
     assert_eq!(rows.len(), 3);
@@ -118,7 +118,7 @@ fn point_maps_are_measured_against_ray_traced_visibility() {
 fn composites_count_what_the_hierarchy_and_the_maps_left_out() {
     let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
     let plan = Plan { size: (64, 48), ..PLAN };
-    let case = CompositeCase::new(&gpu, "ar_room", trade::BEST_METHOD, &plan).expect("ar_room");
+    let case = CompositeCase::new(&gpu, "ar_room", light_extract::DEFAULT_METHOD, &plan).expect("ar_room");
     let at = |passes, patch_maps| {
         Setting::Composite(CompositeSetting { patch_maps, ..CompositeSetting::new(passes, false) })
     };

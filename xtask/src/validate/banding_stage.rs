@@ -8,7 +8,7 @@ use light_extract::Decomposition;
 use std::fmt::Write as _;
 use trade::{BandingCase, BandingRow, Interleave, Shadow, measure_banding};
 
-use super::composite_stage::WritePng;
+use crate::common::WritePng;
 
 /// The stage's results.
 pub(super) struct BandingStage {

@@ -5,6 +5,7 @@
 
 use std::fmt::Write as _;
 
+use crate::common::WritePng;
 use differential_composite::gpu::{GpuCompositor, GpuSettings};
 use differential_composite::measure::{Row, figure3_datasets, rows};
 use differential_composite::{CodeError, Mode, Session, SessionSettings, code_error};
@@ -14,9 +15,6 @@ use real_scene::{PhotoSettings, RealScene};
 
 /// Where the sphere sits, from the floor's centre: on the ground in front of the boxes.
 const AT: Vec3 = Vec3::new(0.0, 0.3, 1.0);
-
-/// Writes an image (name, size, 8-bit RGB) and returns its `<img>` element.
-pub(super) type WritePng<'a> = dyn Fn(&str, (u32, u32), &[u8]) -> Result<String, String> + 'a;
 
 /// The stage's results.
 pub(super) struct Compositing {
@@ -36,7 +34,7 @@ pub(super) struct Compositing {
 pub(super) fn run(gpu: &Gpu, quick: bool) -> Result<Compositing, String> {
     let (size, spp) = if quick { ((160, 120), 8) } else { ((320, 240), 16) };
     let scene = RealScene::builtin("ar_ground").map_err(|e| e.to_string())?;
-    let (map, lights) = crate::shafts::environment(&scene)?;
+    let (map, lights) = crate::common::environment(&scene)?;
     let settings = SessionSettings {
         size: Some(size),
         photo: PhotoSettings { spp, ..SessionSettings::default().photo },

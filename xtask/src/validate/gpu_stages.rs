@@ -7,10 +7,9 @@ use super::{MaskRow, Plan};
 use envmap_sphere::EnvMap;
 use glam::Vec3;
 use gpu::{
-    Background, GBufferPass, Gpu, InterleavedFrame, JointBilateral, LightShape, PrecomputedVisibility,
-    PrefilterSettings, Receivers, SceneGeometry, ShadeLight, ShadeParams, ShadingPass, ShadowGeometry, ShadowTechnique,
-    SpecularAmbient, SplitFrame, SplitPasses, SplitSettings, UpsamplePass, Visibility, WEBER_FRACTION,
-    render_interleaved, render_split, render_visibility, weber_negligible,
+    Background, FrameLights, FrameShadows, GBufferPass, Gpu, JointBilateral, LightShape, LitFrame, LitSettings,
+    PrecomputedVisibility, PrefilterSettings, Receivers, ReferenceReceivers, SceneGeometry, ShadeLight, ShadowGeometry,
+    ShadowTechnique, SpecularAmbient, SplitSettings, Visibility,
 };
 use penumbra_wedge::{WedgeSettings, Wedges};
 use ref_tracer::SceneBvh;
@@ -34,7 +33,6 @@ pub(super) struct GpuImage {
 pub(super) struct Passes {
     pub(super) gbuffer: GBufferPass,
     pub(super) shadows: ShadowMapper,
-    pub(super) shading: ShadingPass,
 }
 
 /// Ray-traced visibility of each light from the G-buffer's points (2 × 2 stratified directions,
@@ -92,7 +90,9 @@ fn techniques(gpu: &Gpu, scene: &scene::Scene, plan: &Plan) -> Result<Vec<NamedT
 }
 
 /// The extracted lights on the GPU with every technique of [`techniques`], and without shadows
-/// (the last image).
+/// (the last image), each frame the toolkit's recorded frame ([`gpu::LitFrame`]) with its
+/// receivers read back and reduced on the CPU ([`ReferenceReceivers::CpuPoints`]): the
+/// reference its GPU-gated frame is tested against, waited for and its lights timed.
 pub(super) fn gpu_render(
     gpu: &Gpu,
     passes: &Passes,
@@ -112,13 +112,14 @@ pub(super) fn gpu_render(
     scene.camera = *grid.camera();
     let scene = &scene;
     let geometry = SceneGeometry::upload(gpu, scene).map_err(e)?;
+    // the ray-traced truth's receivers: its rays start from the G-buffer's points
     let gb = passes.gbuffer.render(gpu, &geometry, &scene.camera).map_err(e)?;
     let points = gb.read_points(gpu).map_err(e)?;
     let receivers = Receivers::new(&gb, &points);
     let lights: Vec<ShadeLight> = d.lights.iter().map(|l| ShadeLight::from(&l.light)).collect();
     let shapes: Vec<LightShape> = d.lights.iter().map(|l| LightShape::from(&l.light)).collect();
-    let (w, h) = gb.size();
-    let pass = &passes.shading;
+    let lit = LitFrame::new(gpu, gb.size()).map_err(e)?;
+    let view = GBufferPass::camera_view(&geometry, &scene.camera);
     let background = Background::upload(gpu, map).map_err(e)?;
     // the ambient map on the specular lobe, for scenes that have one
     let glossy = scene.objects.iter().any(|o| o.material.specular.is_some());
@@ -131,12 +132,16 @@ pub(super) fn gpu_render(
         Some(_) => "SH9 + prefiltered specular ambient",
         None => "SH9 ambient (no glossy surface: no specular prefiltering)",
     };
-    let params = ShadeParams {
+    let whole = FrameLights {
         lights: &lights,
+        shapes: &shapes,
+        directs: lights.len(),
         ambient: Some(&d.ambient_sh),
-        background: Some(&background),
         specular_ambient: specular.as_ref(),
+        background: Some(&background),
     };
+    // lights whose shadow no visible receiver could tell apart (Weber's law) get no pass
+    let settings = LitSettings { split: SplitSettings::default(), weber: true, time_lights: true };
     let common = start.elapsed().as_secs_f64();
     let mut out = Vec::new();
     let mut all = techniques(gpu, scene, plan)?;
@@ -144,17 +149,15 @@ pub(super) fn gpu_render(
         "gpu_traced_visibility".into(),
         Box::new(traced_visibility(gpu, scene, &receivers, &shapes, plan.truth_directions)?),
     ));
-    // lights whose shadow no visible receiver could tell apart (Weber's law) get no pass
-    let negligible = weber_negligible(&receivers, &lights, Some(&d.ambient_sh), WEBER_FRACTION);
-    let mut wedges = None;
     for (name, technique) in &all {
         let t = Instant::now();
-        let vis = Visibility::new(gpu, w, h, lights.len() as u32).map_err(e)?;
-        let reports = render_visibility(gpu, technique.as_ref(), &receivers, &shapes, &negligible, &vis).map_err(e)?;
-        let image = grid.resolve(&pass.render(gpu, &geometry, &gb, &params, &vis).map_err(e)?);
+        let shadows = FrameShadows { direct: technique.as_ref(), indirect: technique.as_ref() };
+        let frame = lit
+            .render_reference(gpu, &geometry, &view, &whole, shadows, &settings, ReferenceReceivers::CpuPoints)
+            .map_err(e)?;
+        let (image, reports) = finished(gpu, frame, technique.as_ref())?;
         let (time, shadowed, _, _) = gpu::totals(&reports);
         let shadow_ms = time.as_secs_f64() * 1e3;
-        let seconds = common + t.elapsed().as_secs_f64();
         out.push(GpuImage {
             what: format!(
                 "GPU: {} lights with {} ({shadowed} shadowed{}; {shadow_ms:.1} ms), + {ambient}",
@@ -163,75 +166,81 @@ pub(super) fn gpu_render(
                 skip_summary(&reports),
             ),
             name: name.clone(),
-            image,
-            seconds,
+            image: grid.resolve(&image),
+            seconds: common + t.elapsed().as_secs_f64(),
         });
-        if name == "gpu_wedges" {
-            wedges = Some((technique.as_ref(), vis, reports, seconds));
-        }
     }
     let directs = d.directs();
-    if let Some((technique, vis, reports, seconds)) = wedges
+    if let Some((_, technique)) = all.iter().find(|(n, _)| n == "gpu_wedges")
         && directs < lights.len()
     {
-        // paper 001's frame: the EnvDirects' wedges at full resolution (the layers above),
-        // the EnvIndirects' at 1/2 or 1/4 of the output's resolution, upsampled
-        let frame = SplitFrame {
-            lit: gpu::FrameLights {
-                lights: &lights,
-                shapes: &shapes,
-                directs,
-                ambient: Some(&d.ambient_sh),
-                specular_ambient: specular.as_ref(),
-                background: Some(&background),
-            },
-            targets: None,
-        };
-        let upsample_pass = UpsamplePass::new(gpu);
-        let split_passes = SplitPasses { gbuffer: &passes.gbuffer, shading: pass, upsample: &upsample_pass };
-        let direct_ms = gpu::totals(&reports[..directs]).0.as_secs_f64() * 1e3;
-        let all_ms = gpu::totals(&reports).0.as_secs_f64() * 1e3;
+        // paper 001's frame: the EnvDirects' wedges at full resolution, the EnvIndirects' at
+        // 1/2 or 1/4 of the output's resolution, upsampled
+        let split_lights = FrameLights { directs, ..whole };
+        let shadows = FrameShadows { direct: technique.as_ref(), indirect: technique.as_ref() };
         for (suffix, scale, upsample, how) in [
             ("half", 2, JointBilateral::PAPER, "joint bilateral"),
             ("quarter", 4, JointBilateral::PAPER, "joint bilateral"),
             ("half_gaussian", 2, JointBilateral::GAUSSIAN, "Gaussian"),
         ] {
             let t = Instant::now();
-            let settings = SplitSettings { indirect_scale: scale * ss, upsample };
-            let split = render_split(gpu, &split_passes, &geometry, (&receivers, &vis), &frame, technique, &settings)
+            let settings = LitSettings { split: SplitSettings { indirect_scale: scale * ss, upsample }, ..settings };
+            let frame = lit
+                .render_reference(
+                    gpu,
+                    &geometry,
+                    &view,
+                    &split_lights,
+                    shadows,
+                    &settings,
+                    ReferenceReceivers::CpuPoints,
+                )
                 .map_err(e)?;
-            let image = grid.resolve(&gpu::read_hdr(gpu, &split.texture).map_err(e)?);
-            let indirect_ms = gpu::totals(&split.indirect_reports).0.as_secs_f64() * 1e3;
-            let (lw, lh) = split.indirect_size;
+            let (image, reports) = finished(gpu, frame, technique.as_ref())?;
+            let direct_ms = gpu::totals(&reports[..directs]).0.as_secs_f64() * 1e3;
+            let indirect_ms = gpu::totals(&reports[directs..]).0.as_secs_f64() * 1e3;
+            let (lw, lh) = (gb.size().0 / (scale * ss), gb.size().1 / (scale * ss));
             let pitch = f64::from(scale * ss) / f64::from(grid.samples_per_pixel()).sqrt();
             out.push(GpuImage {
                 name: format!("gpu_wedges_indirects_{suffix}"),
                 what: format!(
                     "GPU, paper 001's split: {directs} EnvDirects with wedges at full resolution ({direct_ms:.1} ms), {} EnvIndirects with wedges at {lw}x{lh} (a sample every {pitch:.2} pixels; {indirect_ms:.1} ms{}), {how} upsampling, + {ambient}",
                     lights.len() - directs,
-                    skip_summary(&split.indirect_reports),
+                    skip_summary(&reports[directs..]),
                 ),
-                image,
-                // the wedges row's common work and its directs' share of the shadow work, and this
-                // frame's own
-                seconds: common + (seconds - common) * direct_ms / all_ms.max(1e-9) + t.elapsed().as_secs_f64(),
+                image: grid.resolve(&image),
+                seconds: common + t.elapsed().as_secs_f64(),
             });
         }
     }
     if plan.interleaved {
         let sets: Vec<Vec<scene::DistantLight>> =
             std::iter::once(d.distant_lights()).chain(d.interleaved_distant_lights()).collect();
+        let shade: Vec<Vec<ShadeLight>> = sets.iter().map(|s| s.iter().map(ShadeLight::from).collect()).collect();
+        let set_shapes: Vec<Vec<LightShape>> = sets.iter().map(|s| s.iter().map(LightShape::from).collect()).collect();
+        let frames: Vec<FrameLights> = shade
+            .iter()
+            .zip(&set_shapes)
+            .map(|(l, s)| FrameLights { lights: l, shapes: s, directs: l.len(), ..whole })
+            .collect();
         for (name, technique) in all.iter().filter(|(n, _)| n == "gpu_shadow_maps" || n == "gpu_wedges") {
             let t = Instant::now();
-            let frame = InterleavedFrame {
-                geometry: &geometry,
-                receivers: &receivers,
-                params: &params,
-                negligible: &negligible,
-            };
-            let (image, reports) = render_interleaved(gpu, pass, &frame, technique.as_ref(), &sets).map_err(e)?;
+            let shadows = FrameShadows { direct: technique.as_ref(), indirect: technique.as_ref() };
+            let interleaved = lit
+                .render_interleaved(
+                    gpu,
+                    &geometry,
+                    &view,
+                    &frames,
+                    shadows,
+                    &settings,
+                    Some(ReferenceReceivers::CpuPoints),
+                )
+                .map_err(e)?;
+            gpu.wait(None).map_err(e)?;
+            let (texture, reports) = interleaved.finish_reports(gpu).map_err(e)?;
             let ms = gpu::totals(&reports).0.as_secs_f64() * 1e3;
-            let image = gpu::read_hdr(gpu, &image).map_err(e)?;
+            let image = gpu::read_hdr(gpu, &texture).map_err(e)?;
             out.push(GpuImage {
                 name: format!("{name}_interleaved"),
                 what: format!(
@@ -247,15 +256,30 @@ pub(super) fn gpu_render(
             });
         }
     }
-    let lit = Visibility::new(gpu, w, h, lights.len() as u32).map_err(e)?;
-    let unshadowed = grid.resolve(&pass.render(gpu, &geometry, &gb, &params, &lit).map_err(e)?);
+    let frame = lit.render(gpu, &geometry, &view, &whole, None, &settings).map_err(e)?;
+    gpu.wait(None).map_err(e)?;
+    let (texture, _) = frame.finish_reports(gpu).map_err(e)?;
     out.push(GpuImage {
         name: "gpu_unshadowed".into(),
         what: "GPU: the same lights without shadows".into(),
-        image: unshadowed,
+        image: grid.resolve(&gpu::read_hdr(gpu, &texture).map_err(e)?),
         seconds: 0.0,
     });
     Ok(out)
+}
+
+/// A frame waited for: its image read back and its reports completed with the technique's
+/// counts and what the GPU knew.
+fn finished(
+    gpu: &Gpu,
+    mut frame: gpu::RenderedFrame,
+    technique: &dyn ShadowTechnique,
+) -> Result<(Vec<Vec3>, Vec<gpu::ShadowPassReport>), String> {
+    let e = |e: gpu::GpuError| e.to_string();
+    gpu.wait(None).map_err(e)?;
+    technique.read_counts(gpu, &mut frame.reports).map_err(e)?;
+    let (texture, reports) = frame.finish_reports(gpu).map_err(e)?;
+    Ok((gpu::read_hdr(gpu, &texture).map_err(e)?, reports))
 }
 
 /// ", N skipped: why" per reason, or nothing.

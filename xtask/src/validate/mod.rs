@@ -10,11 +10,11 @@ mod composite_stage;
 mod gpu_stages;
 mod readme;
 mod report;
-mod thresholds;
 
-use crate::render::load_map;
+use crate::common::load_map;
+use crate::thresholds::load_thresholds;
 use glam::Vec3;
-use gpu::{GBufferPass, ShadingPass};
+use gpu::GBufferPass;
 use gpu_stages::{MaskImages, Passes, SizeRow, gpu_render, room_masks};
 use ref_tracer::metrics::{FlipTonemap, flip, rmse};
 use ref_tracer::{EnvLight, Integrator, LightSet, RenderSettings, SceneBvh, Strategy};
@@ -23,8 +23,6 @@ use shadowmap_paraboloid::{ShadowMapper, ShadowSettings, Technique};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::time::Instant;
-use thresholds::load_thresholds;
-pub use thresholds::{THRESHOLDS, parse_thresholds};
 
 /// Options of `cargo xtask validate`.
 #[derive(clap::Parser, Clone, Debug)]
@@ -37,7 +35,7 @@ pub struct ValidateArgs {
     pub scene: String,
     /// Light extraction method (as `cargo xtask extract --method`); the default is the most
     /// accurate in `eval-lights`. Other methods' threshold keys carry the method.
-    #[arg(long, default_value = DEFAULT_METHOD)]
+    #[arg(long, default_value = light_extract::DEFAULT_METHOD)]
     pub method: String,
     /// Smaller images and fewer samples: about 40 s on 2 cores once built.
     #[arg(long)]
@@ -70,10 +68,6 @@ pub struct ValidateArgs {
     #[arg(long, value_name = "MS")]
     pub budget_ms: Option<f64>,
 }
-
-/// `validate`'s extraction: paper 001's emissive split with our options (0.45x median cut's
-/// RMSE on the shared maps in `eval-lights`).
-pub const DEFAULT_METHOD: &str = "emissive-split+moment-cones+above-horizon+residual";
 
 /// The row of env-direct given the GPU's time: its error depends on the machine's speed, so the
 /// README check and the thresholds leave it out.
@@ -246,11 +240,7 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
     let traced_s = t.elapsed().as_secs_f64();
 
     stages.next(&format!("GPU: G-buffer, shadow techniques (maps, PCSS, N maps, wedges), shading ({})", gpu.info.name));
-    let passes = Passes {
-        gbuffer: GBufferPass::new(&gpu),
-        shadows: ShadowMapper::new(&gpu),
-        shading: ShadingPass::new(&gpu).map_err(|e| e.to_string())?,
-    };
+    let passes = Passes { gbuffer: GBufferPass::new(&gpu), shadows: ShadowMapper::new(&gpu) };
     let gpu_images = gpu_render(&gpu, &passes, &scene, &map, &decomposition, &plan)?;
 
     // paper 001's Figure 1: env-direct given the time the GPU's split frame took, here
@@ -335,7 +325,8 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
 
     stages.next("report and thresholds");
     std::fs::create_dir_all(&args.out).map_err(|e| format!("{}: {e}", args.out.display()))?;
-    let method = if args.method == DEFAULT_METHOD { String::new() } else { format!("[{}]", args.method) };
+    let method =
+        if args.method == light_extract::DEFAULT_METHOD { String::new() } else { format!("[{}]", args.method) };
     let key = format!("{}@{}{method}{}", args.scene, map_name, if args.quick { "/quick" } else { "" });
     let mut measured: BTreeMap<String, f64> = BTreeMap::new();
     for r in &rows {

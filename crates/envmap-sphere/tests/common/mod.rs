@@ -9,13 +9,13 @@ use std::path::PathBuf;
 
 /// The repository's test maps (`assets/envmaps`, or `ENVSHADOW_ENVMAPS`).
 pub fn envmaps_dir() -> PathBuf {
-    envmap_sphere::test_set::dir()
+    test_set::dir()
 }
 
 /// Every map of the test set, sorted. Panics when they are missing: the tests that use them must
 /// not pass vacuously.
 pub fn shared_maps() -> Vec<PathBuf> {
-    envmap_sphere::test_set::maps().unwrap_or_else(|e| panic!("{e}"))
+    test_set::maps().unwrap_or_else(|e| panic!("{e}"))
 }
 
 pub fn rng(seed: u64) -> Pcg64Mcg {

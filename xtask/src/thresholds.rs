@@ -5,7 +5,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
 /// The checked-in thresholds, embedded so that a binary copied elsewhere still has them.
-pub const THRESHOLDS: &str = include_str!("../../../validate/thresholds.json");
+pub const THRESHOLDS: &str = include_str!("../../validate/thresholds.json");
 
 /// The thresholds file: a limit per measured key, and the keys measured for the report only.
 #[derive(Debug, Default)]

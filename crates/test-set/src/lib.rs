@@ -4,6 +4,8 @@
 //!
 //! The folder is found through this crate's source location, so it is there in a clone of the
 //! repository, not beside a binary copied elsewhere: commands that take maps also take a path.
+//! That is why this is a crate of its own and not part of `envmap-sphere`'s API: no library
+//! crate reads the repository's folders.
 
 use std::path::{Path, PathBuf};
 
