@@ -4,16 +4,16 @@
 //! capture is not timed. Under `cargo test` (one smoke run) the room is built twice as coarse.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use real_scene::{PatchBvh, Perturbation, RealScene, SolveSettings, solve};
-use shaft_hierarchy::measure::object_path;
+use real_scene::{Perturbation, RealScene, SolveSettings, solve};
 use shaft_hierarchy::preprocess::{PreprocessSettings, build};
 use shaft_hierarchy::{Occlusion, Traversal};
+use trade::shafts::object_path;
 
 fn shafts(c: &mut Criterion) {
     let full = std::env::args().any(|a| a == "--bench");
     let perturbation = Perturbation { coarsen: if full { 1 } else { 2 }, ..Perturbation::NONE };
     let mut scene = RealScene::builtin_with("ar_room", &perturbation).unwrap_or_else(|e| panic!("{e}"));
-    let bvh = PatchBvh::new(&scene);
+    let bvh = ref_tracer::SceneBvh::new(&scene.to_scene());
     solve(&mut scene, &bvh, None, &SolveSettings::default()).unwrap_or_else(|e| panic!("{e}"));
     let settings = PreprocessSettings::PAPER;
     let mut group = c.benchmark_group(format!("shafts_{}_patches", scene.patches.len()));

@@ -23,7 +23,7 @@ pub fn load_map(path: Option<&Path>) -> Result<EnvMap, String> {
 /// An environment-lit scene's map (the embedded one) and its extracted lights as distant
 /// sources; nothing for a scene lit by its own patches.
 pub fn environment(scene: &RealScene) -> Result<(Option<EnvMap>, Vec<scene::DistantLight>), String> {
-    differential_composite::setup::environment(scene, light_extract::DEFAULT_METHOD, 32).map_err(|e| e.to_string())
+    trade::session::environment(scene, light_extract::DEFAULT_METHOD, 32).map_err(|e| e.to_string())
 }
 
 /// Writes an image (name, size, 8-bit RGB) and returns its `<img>` element.

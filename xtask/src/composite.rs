@@ -6,11 +6,12 @@
 use std::path::{Path, PathBuf};
 
 use differential_composite::gpu::{GpuCompositor, GpuSettings};
-use differential_composite::measure::{figure3_datasets, ms, rows};
-use differential_composite::{Mode, Session, SessionSettings, code_error};
+use differential_composite::{Mode, code_error};
 use glam::Vec3;
-use real_scene::{Perturbation, PhotoSettings, RealScene};
+use real_scene::{Perturbation, RealScene};
 use shaft_hierarchy::preprocess::PreprocessSettings;
+use trade::composite_rows::{figure3_datasets, ms, rows};
+use trade::{PhotoSettings, Session, SessionSettings};
 
 use crate::common::parse_size;
 

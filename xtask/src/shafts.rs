@@ -7,10 +7,10 @@
 use std::path::Path;
 use std::time::Instant;
 
-use real_scene::{PatchBvh, RealScene, SolveSettings, Visibility};
-use shaft_hierarchy::measure::{figures, object_path, overlay, sweep};
+use real_scene::{RealScene, SolveSettings, Visibility};
 use shaft_hierarchy::preprocess::PreprocessSettings;
 use shaft_hierarchy::{Occlusion, Traversal};
+use trade::shafts::{figures, object_path, overlay, sweep};
 
 /// Frames of the object path.
 const FRAMES: usize = 240;
@@ -37,7 +37,7 @@ pub fn run(args: &ShaftsArgs) -> Result<(), String> {
     };
     let mut scene = RealScene::builtin(args.scene).map_err(|e| e.to_string())?;
     let t = Instant::now();
-    let bvh = PatchBvh::new(&scene);
+    let bvh = ref_tracer::SceneBvh::new(&scene.to_scene());
     let (map, lights) = crate::common::environment(&scene)?;
     let report =
         real_scene::solve(&mut scene, &bvh, map.as_ref(), &SolveSettings::default()).map_err(|e| e.to_string())?;
@@ -166,7 +166,7 @@ pub fn run(args: &ShaftsArgs) -> Result<(), String> {
             c.in_pruned,
             100.0 * c.found as f64 / c.true_occluders.max(1) as f64,
             100.0 * c.unconfirmed as f64 / c.reported.max(1) as f64,
-            shaft_hierarchy::measure::CONFIRM_SEGMENTS
+            trade::shafts::CONFIRM_SEGMENTS
         ));
         say(&format!("wrote {}", png.display()));
     }
@@ -180,9 +180,8 @@ pub fn run(args: &ShaftsArgs) -> Result<(), String> {
 /// auto-exposed camera response to 8 bits (OUT/<scene>_photo.png).
 fn photograph(scene: &RealScene, map: Option<&envmap_sphere::EnvMap>, spp: u32, out: &Path) -> Result<(), String> {
     let t = Instant::now();
-    let photo =
-        real_scene::photograph(scene, map, &real_scene::PhotoSettings { spp, ..real_scene::PhotoSettings::default() })
-            .map_err(|e| e.to_string())?;
+    let photo = trade::photograph(scene, map, &trade::PhotoSettings { spp, ..trade::PhotoSettings::default() })
+        .map_err(|e| e.to_string())?;
     let response = real_scene::CameraResponse::auto(&photo.color);
     std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
     let exr = out.join(format!("{}_photo.exr", scene.name));

@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 use envmap_sphere::{EnvMap, Sh9};
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
-use real_scene::{CameraResponse, PatchBvh, RealScene, Visibility, luminance};
+use real_scene::{CameraResponse, RealScene, Visibility, luminance};
 use scene::DistantLight;
 use shaft_hierarchy::preprocess::{Origin, Prepared, Source};
 use shaft_hierarchy::{Occlusion, ShaftHierarchy, Traversal};
@@ -67,7 +67,7 @@ pub struct Compositor {
     vertex_colour: Vec<Vec3>,
     /// Per source, its set in the two-set split (paper: the parity of a random id).
     pub set_of: Vec<u8>,
-    bvh: PatchBvh,
+    bvh: Box<dyn Visibility>,
 }
 
 /// One representative's share of a frame.
@@ -118,7 +118,9 @@ impl Frame {
 
 impl Compositor {
     /// The compositor for `model` (radiosity solved) photographed as `photo_hdr` through
-    /// `response`, with `prepared` and `hierarchy` built from it.
+    /// `response`, with `prepared` and `hierarchy` built from it; `model_rays` answers ray
+    /// queries against the model, one object per patch of [`RealScene::to_scene`] (the
+    /// caller's tracer: the compositor traces no rays of its own).
     ///
     /// # Errors
     /// [`CompositeError::Parameter`] when the photograph's size is not the model camera's.
@@ -129,6 +131,7 @@ impl Compositor {
         (prepared, hierarchy): (Prepared, ShaftHierarchy),
         photo_hdr: Vec<Vec3>,
         response: CameraResponse,
+        model_rays: Box<dyn Visibility>,
     ) -> Result<Self, CompositeError> {
         let size = (model.camera.width, model.camera.height);
         if photo_hdr.len() != size.0 as usize * size.1 as usize {
@@ -139,7 +142,7 @@ impl Compositor {
                 size.1
             )));
         }
-        let bvh = PatchBvh::new(&model);
+        let bvh = model_rays;
         let photo_ldr = photo_hdr.iter().map(|c| response.apply(*c)).collect();
         let over_luminance = |c: Vec3| {
             let y = luminance(c);
@@ -162,7 +165,7 @@ impl Compositor {
             prepared.receivers.iter().flat_map(|&r| [model.patches[r as usize].radiance; 4]).collect();
         let mut rng = rand_pcg::Pcg32::seed_from_u64(3);
         let set_of = prepared.sources.iter().map(|_| (rng.random::<u32>() & 1) as u8).collect();
-        let pixels = pixel_refs(&model, &prepared, &bvh);
+        let pixels = pixel_refs(&model, &prepared, bvh.as_ref());
         Ok(Self {
             model,
             lights,
@@ -184,8 +187,8 @@ impl Compositor {
 
     /// The model's visibility queries.
     #[must_use]
-    pub fn model_bvh(&self) -> &PatchBvh {
-        &self.bvh
+    pub fn model_bvh(&self) -> &dyn Visibility {
+        self.bvh.as_ref()
     }
 
     /// RGB transfer of source `j` (hierarchy order) to receiver vertex `slot`.
@@ -309,7 +312,7 @@ impl Compositor {
 }
 
 /// Each pixel's receiver: the centre ray's first patch, its slot and bilinear weights.
-fn pixel_refs(model: &RealScene, prepared: &Prepared, bvh: &PatchBvh) -> Vec<PixelRef> {
+fn pixel_refs(model: &RealScene, prepared: &Prepared, bvh: &dyn Visibility) -> Vec<PixelRef> {
     let cam = &model.camera;
     let rays = cam.rays();
     let mut receiver_of = vec![u32::MAX; model.patches.len()];

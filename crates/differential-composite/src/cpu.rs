@@ -6,31 +6,29 @@
 use glam::Vec3;
 use rayon::prelude::*;
 use real_scene::Visibility;
-use ref_tracer::SceneBvh;
 use shaft_hierarchy::preprocess::Origin;
 
 use crate::compositor::{Compositor, Frame};
 use crate::{Mode, SyntheticObject};
 
-/// An object's ray-tracing structures: the shaded mesh (what the camera sees) and the
+/// An object's ray queries: against the shaded mesh (what the camera sees) and the
 /// shadow-casting one.
 pub struct ObjectBvh {
-    seen: SceneBvh,
-    caster: SceneBvh,
+    seen: Box<dyn Visibility>,
+    caster: Box<dyn Visibility>,
 }
 
+/// Builds the ray queries of a scene (the caller's tracer, e.g. `ref_tracer::SceneBvh`).
+pub type BuildRays<'a> = dyn Fn(&scene::Scene) -> Box<dyn Visibility> + 'a;
+
 impl ObjectBvh {
-    /// For `object`, its shadows cast from `shadow_mesh`; `camera` is the scene's.
+    /// For `object`, its shadows cast from `shadow_mesh`; `camera` is the scene's; `build`
+    /// makes each mesh's ray queries (a scene of that one object).
     #[must_use]
-    pub fn new(object: &SyntheticObject, shadow_mesh: &scene::Mesh, camera: scene::Camera) -> Self {
+    pub fn new(object: &SyntheticObject, shadow_mesh: &scene::Mesh, camera: scene::Camera, build: &BuildRays) -> Self {
         let one = |mesh: &scene::Mesh| {
             let o = scene::Object { mesh: mesh.clone(), ..object.to_object() };
-            SceneBvh::new(&scene::Scene {
-                name: object.name.clone(),
-                objects: vec![o],
-                camera,
-                point_lights: Vec::new(),
-            })
+            build(&scene::Scene { name: object.name.clone(), objects: vec![o], camera, point_lights: Vec::new() })
         };
         Self { seen: one(&object.mesh), caster: one(shadow_mesh) }
     }
@@ -59,7 +57,7 @@ pub fn object_pixels(c: &Compositor, bvh: &ObjectBvh) -> Vec<bool> {
             let (o, d) = rays.ray((k % w) as f32 + 0.5, (k / w) as f32 + 0.5);
             let px = c.pixels[k as usize];
             let behind = if px.position.is_finite() { (px.position - o).length() } else { f32::INFINITY };
-            bvh.seen.intersect(o, d, behind).is_some()
+            bvh.seen.first_hit(o, d).is_some_and(|(_, t)| t < behind)
         })
         .collect()
 }
@@ -91,9 +89,9 @@ pub fn composite(c: &Compositor, frame: &Frame, object: &SyntheticObject, bvh: &
                     let (o, d) = rays.ray(x as f32 + dx, y as f32 + dy);
                     // the object's few hundred triangles first: the model is traced only where
                     // a ray finds the object, to see whether something stands in front of it
-                    let Some(hit) = bvh.seen.intersect(o, d, f32::INFINITY) else { continue };
-                    if c.model_bvh().first_hit(o, d).is_none_or(|m| m.1 > hit.t) {
-                        let n = if hit.shading_normal.dot(d) > 0.0 { -hit.shading_normal } else { hit.shading_normal };
+                    let Some((t, normal)) = bvh.seen.first_hit_normal(o, d) else { continue };
+                    if c.model_bvh().first_hit(o, d).is_none_or(|m| m.1 > t) {
+                        let n = if normal.dot(d) > 0.0 { -normal } else { normal };
                         covered += 1;
                         object_radiance += shade(n);
                     }

@@ -2,8 +2,6 @@
 //! (paper 003, Sections 7-9; Debevec 1998).
 //!
 //! - [`object`]: the built-in synthetic objects and their simplified shadow meshes.
-//! - [`offline`]: the truth (the real scene path traced with the object) and Debevec's
-//!   differential rendering with the reconstructed model, on the CPU.
 //! - [`compositor`]: what the interactive compositor knows of the scene (each pixel's receiver,
 //!   transfers in RGB) and each frame's representatives with their radiance transfers (HDR)
 //!   and intensity transfers (LDR).
@@ -12,8 +10,10 @@
 //! - [`cpu`]: masks by ray casting and the subtraction, the reference compositor.
 //! - [`gpu`]: the interactive compositor: shadow maps, masks, darkening and resolve on wgpu.
 //! - [`metrics`]: errors in 8-bit codes.
-//! - [`measure`]: each setting's error and time, Figure 3's datasets.
-//! - [`setup`]: a session on a built-in real scene: capture, reconstruction, truth, Debevec.
+//!
+//! The capture, the truth and Debevec's render (path traced) and the measuring are the harness
+//! crate `trade`'s (`trade::session`, `trade::offline`, `trade::composite_rows`): this crate
+//! traces no rays of its own; it asks a `real_scene::Visibility` the caller fills.
 //!
 //! **Architecture invariant:** the compositor reads the real scene only through its
 //! reconstruction (`real_scene::RealScene` as the model, the photograph, the camera response);
@@ -23,16 +23,12 @@ pub mod compositor;
 pub mod cpu;
 pub mod gpu;
 pub mod ldr;
-pub mod measure;
 pub mod metrics;
 pub mod object;
-pub mod offline;
-pub mod setup;
 
 pub use compositor::{Compositor, Frame, PixelRef, RepTransfer};
 pub use metrics::{CodeError, code_error};
 pub use object::{BUILTIN_OBJECTS, SyntheticObject};
-pub use setup::{Session, SessionSettings};
 
 /// Which framebuffer the compositor subtracts in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

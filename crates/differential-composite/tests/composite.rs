@@ -6,11 +6,17 @@ use std::sync::OnceLock;
 
 use differential_composite::cpu::{ObjectBvh, composite, object_pixels};
 use differential_composite::gpu::{GpuCompositor, GpuSettings};
-use differential_composite::{Compositor, Frame, Mode, Session, SessionSettings, SyntheticObject};
+use differential_composite::{Compositor, Frame, Mode, SyntheticObject};
 use glam::Vec3;
-use real_scene::{Perturbation, PhotoSettings, luminance};
+use real_scene::{Perturbation, luminance};
+use trade::{PhotoSettings, Session, SessionSettings};
 
 const SIZE: (u32, u32) = (80, 60);
+
+/// The tests' tracer for the compositor's ray queries.
+fn rays(scene: &scene::Scene) -> Box<dyn real_scene::Visibility> {
+    Box::new(ref_tracer::SceneBvh::new(scene))
+}
 
 fn settings(reconstruction: Perturbation, estimate: bool) -> SessionSettings {
     SessionSettings {
@@ -44,7 +50,7 @@ fn sphere(s: &Session, at: Vec3) -> SyntheticObject {
 }
 
 fn cpu_composite(s: &Session, frame: &Frame, object: &SyntheticObject, mode: Mode) -> Vec<[u8; 3]> {
-    let bvh = ObjectBvh::new(object, &object.mesh, s.compositor.model.camera);
+    let bvh = ObjectBvh::new(object, &object.mesh, s.compositor.model.camera, &rays);
     composite(&s.compositor, frame, object, &bvh, mode)
 }
 
@@ -57,7 +63,7 @@ fn gpu_composite(frame: &Frame, object: &SyntheticObject, mode: Mode) -> Vec<[u8
 
 /// Pixels on the object or next to it (its silhouette's antialiasing reaches one pixel).
 fn near_object(c: &Compositor, object: &SyntheticObject) -> Vec<bool> {
-    let on = object_pixels(c, &ObjectBvh::new(object, &object.mesh, c.model.camera));
+    let on = object_pixels(c, &ObjectBvh::new(object, &object.mesh, c.model.camera, &rays));
     let (w, h) = (c.size.0 as i64, c.size.1 as i64);
     (0..w * h)
         .map(|k| {

@@ -5,8 +5,9 @@
 //! map) and their radiances come from a radiosity solution ([`solve`]), checked against closed
 //! forms. [`Perturbation`] makes the reconstruction imperfect on purpose.
 //!
-//! Visibility is asked of a [`Visibility`] (the BVH behind it), so nothing here depends on how
-//! rays are traced; [`PatchBvh`] answers it with `ref-tracer`'s BVH.
+//! Visibility is asked of a [`Visibility`] (`scene`'s trait; the caller's BVH behind it, one
+//! object per patch of [`RealScene::to_scene`]), so nothing here depends on how rays are traced:
+//! `ref_tracer::SceneBvh` answers it.
 
 mod builtin;
 pub mod formfactor;
@@ -14,8 +15,9 @@ mod photo;
 mod radiosity;
 
 pub use builtin::{BUILTIN_REAL_SCENES, Perturbation};
-pub use photo::{CameraResponse, PhotoSettings, photograph, photograph_with};
+pub use photo::CameraResponse;
 pub use radiosity::{SolveReport, SolveSettings, estimate_reflectances, solve};
+pub use scene::Visibility;
 
 use glam::Vec3;
 
@@ -132,56 +134,6 @@ impl RealScene {
             }
         }
         (0..self.patches.len() as u32).filter(|&p| seen[p as usize]).collect()
-    }
-}
-
-/// Ray queries against the model (its patches): what the solver and the transfers ask.
-pub trait Visibility: Sync {
-    /// True when nothing blocks the segment between `a` and `b` (ends excluded).
-    fn clear(&self, a: Vec3, b: Vec3) -> bool;
-    /// True when the ray from `origin` along unit `dir` leaves the scene.
-    fn escapes(&self, origin: Vec3, dir: Vec3) -> bool;
-    /// The patch a ray from `origin` along unit `dir` hits first, and the distance.
-    fn first_hit(&self, origin: Vec3, dir: Vec3) -> Option<(u32, f32)>;
-    /// A distance that moves a point off its surface (relative to the scene's size).
-    fn epsilon(&self) -> f32;
-}
-
-/// `ref-tracer`'s BVH over a real scene's patches.
-pub struct PatchBvh {
-    bvh: ref_tracer::SceneBvh,
-}
-
-impl PatchBvh {
-    /// Builds the BVH (one object per patch).
-    #[must_use]
-    pub fn new(scene: &RealScene) -> Self {
-        Self { bvh: ref_tracer::SceneBvh::new(&scene.to_scene()) }
-    }
-}
-
-impl Visibility for PatchBvh {
-    fn clear(&self, a: Vec3, b: Vec3) -> bool {
-        let d = b - a;
-        let len = d.length();
-        let eps = self.bvh.epsilon();
-        if len <= 2.0 * eps {
-            return true;
-        }
-        let dir = d / len;
-        !self.bvh.occluded(a + dir * eps, dir, len - 2.0 * eps)
-    }
-
-    fn escapes(&self, origin: Vec3, dir: Vec3) -> bool {
-        !self.bvh.occluded(origin, dir, f32::INFINITY)
-    }
-
-    fn first_hit(&self, origin: Vec3, dir: Vec3) -> Option<(u32, f32)> {
-        self.bvh.intersect(origin, dir, f32::INFINITY).map(|h| (h.object, h.t))
-    }
-
-    fn epsilon(&self) -> f32 {
-        self.bvh.epsilon()
     }
 }
 

@@ -2,7 +2,7 @@
 
 use envmap_sphere::EnvMap;
 use glam::Vec3;
-use real_scene::{Patch, PatchBvh, RealScene, RealSceneError, SolveSettings, solve};
+use real_scene::{Patch, RealScene, RealSceneError, SolveSettings, solve};
 
 fn camera() -> scene::Camera {
     scene::Camera {
@@ -52,7 +52,7 @@ fn cube(n: u32, e: Vec3, rho: Vec3, open_top: bool) -> RealScene {
 fn closed_uniform_room_reaches_e_over_one_minus_rho() {
     for (n, rho) in [(4, 0.5f32), (6, 0.8)] {
         let mut s = cube(n, Vec3::new(1.0, 2.0, 0.5), Vec3::splat(rho), false);
-        let bvh = PatchBvh::new(&s);
+        let bvh = ref_tracer::SceneBvh::new(&s.to_scene());
         let report = solve(&mut s, &bvh, None, &SolveSettings::default()).unwrap();
         let exact = Vec3::new(1.0, 2.0, 0.5) / (1.0 - rho);
         for p in &s.patches {
@@ -76,7 +76,7 @@ fn open_box_under_a_constant_sky_matches_the_aperture_form_factor() {
     for p in s.patches.iter_mut().filter(|p| p.center().y == 0.0) {
         p.reflectance = Vec3::splat(0.5);
     }
-    let bvh = PatchBvh::new(&s);
+    let bvh = ref_tracer::SceneBvh::new(&s.to_scene());
     let sky = EnvMap::constant(64, 32, Vec3::splat(2.0));
     solve(&mut s, &bvh, Some(&sky), &SolveSettings { environment_samples: 128, ..SolveSettings::default() }).unwrap();
     let centre = s.patches.iter().find(|p| (p.center() - Vec3::new(0.5, 0.0, 0.5)).length() < 1e-3).unwrap();
@@ -97,14 +97,14 @@ fn open_box_under_a_constant_sky_matches_the_aperture_form_factor() {
 #[test]
 fn environment_lit_scenes_need_a_map() {
     let mut s = cube(2, Vec3::ZERO, Vec3::splat(0.5), true);
-    let bvh = PatchBvh::new(&s);
+    let bvh = ref_tracer::SceneBvh::new(&s.to_scene());
     assert!(matches!(solve(&mut s, &bvh, None, &SolveSettings::default()), Err(RealSceneError::NeedsEnvironment(_))));
 }
 
 #[test]
 fn ar_room_is_lit_and_finite() {
     let mut s = RealScene::builtin("ar_room").unwrap();
-    let bvh = PatchBvh::new(&s);
+    let bvh = ref_tracer::SceneBvh::new(&s.to_scene());
     let report = solve(&mut s, &bvh, None, &SolveSettings::default()).unwrap();
     assert!(s.patches.iter().all(|p| p.radiance.is_finite() && p.radiance.min_element() >= 0.0));
     // open floor between the table and the window is brighter than under the table
@@ -127,10 +127,9 @@ fn ar_ground_radiosity_matches_path_tracing() {
     let map = envmap_sphere::default_map();
     let mut s = RealScene::builtin("ar_ground").unwrap();
     (s.camera.width, s.camera.height) = (160, 120);
-    let bvh = PatchBvh::new(&s);
+    let bvh = ref_tracer::SceneBvh::new(&s.to_scene());
     solve(&mut s, &bvh, Some(&map), &SolveSettings { environment_samples: 32, ..SolveSettings::default() }).unwrap();
-    let photo =
-        real_scene::photograph(&s, Some(&map), &real_scene::PhotoSettings { spp: 64, max_depth: 8, seed: 1 }).unwrap();
+    let photo = trade::photograph(&s, Some(&map), &trade::PhotoSettings { spp: 64, max_depth: 8, seed: 1 }).unwrap();
     let (errors, ratio) = against_photo(&s, &photo, 16);
     let median = errors[errors.len() / 2];
     assert!(errors.len() > 50, "{} patches seen", errors.len());
@@ -143,12 +142,12 @@ fn photographs_need_the_scenes_own_lighting() {
     let map = EnvMap::constant(16, 8, Vec3::ONE);
     let room = RealScene::builtin("ar_room").unwrap();
     assert!(matches!(
-        real_scene::photograph(&room, Some(&map), &real_scene::PhotoSettings::default()),
+        trade::photograph(&room, Some(&map), &trade::PhotoSettings::default()),
         Err(RealSceneError::NeedsEnvironment(_))
     ));
     let ground = RealScene::builtin("ar_ground").unwrap();
     assert!(matches!(
-        real_scene::photograph(&ground, None, &real_scene::PhotoSettings::default()),
+        trade::photograph(&ground, None, &trade::PhotoSettings::default()),
         Err(RealSceneError::NeedsEnvironment(_))
     ));
 }
@@ -159,10 +158,9 @@ fn photographs_need_the_scenes_own_lighting() {
 fn ar_room_radiosity_matches_path_tracing() {
     let mut s = RealScene::builtin("ar_room").unwrap();
     (s.camera.width, s.camera.height) = (96, 72);
-    let bvh = PatchBvh::new(&s);
+    let bvh = ref_tracer::SceneBvh::new(&s.to_scene());
     solve(&mut s, &bvh, None, &SolveSettings::default()).unwrap();
-    let photo =
-        real_scene::photograph(&s, None, &real_scene::PhotoSettings { spp: 128, max_depth: 12, seed: 1 }).unwrap();
+    let photo = trade::photograph(&s, None, &trade::PhotoSettings { spp: 128, max_depth: 12, seed: 1 }).unwrap();
     let (errors, ratio) = against_photo(&s, &photo, 12);
     let median = errors[errors.len() / 2];
     assert!(errors.len() > 50, "{} patches seen", errors.len());
@@ -203,7 +201,7 @@ fn against_photo(s: &RealScene, photo: &ref_tracer::Render, min_pixels: u32) -> 
 fn estimated_reflectances_recover_the_solved_ones() {
     let map = EnvMap::from_fn(64, 32, |d| if d.y > 0.0 { Vec3::new(0.6, 0.8, 1.2) } else { Vec3::splat(0.05) });
     let mut s = RealScene::builtin("ar_ground").unwrap_or_else(|e| panic!("{e}"));
-    let bvh = PatchBvh::new(&s);
+    let bvh = ref_tracer::SceneBvh::new(&s.to_scene());
     let settings = SolveSettings { tolerance: 1e-7, max_iterations: 400, ..SolveSettings::default() };
     solve(&mut s, &bvh, Some(&map), &settings).unwrap_or_else(|e| panic!("{e}"));
     let solved: Vec<Vec3> = s.patches.iter().map(|p| p.reflectance).collect();

@@ -144,6 +144,26 @@ impl SceneBvh {
     }
 }
 
+/// The tracer answers the ray queries of the crates that must not depend on it (the radiosity
+/// solver, the shaft hierarchy, the compositor): one object per patch gives patch ids.
+impl scene::Visibility for SceneBvh {
+    fn occluded(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
+        SceneBvh::occluded(self, origin, dir, t_max)
+    }
+
+    fn first_hit(&self, origin: Vec3, dir: Vec3) -> Option<(u32, f32)> {
+        self.intersect(origin, dir, f32::INFINITY).map(|h| (h.object, h.t))
+    }
+
+    fn first_hit_normal(&self, origin: Vec3, dir: Vec3) -> Option<(f32, Vec3)> {
+        self.intersect(origin, dir, f32::INFINITY).map(|h| (h.t, h.shading_normal))
+    }
+
+    fn epsilon(&self) -> f32 {
+        SceneBvh::epsilon(self)
+    }
+}
+
 /// Barycentric coordinates (w0, w1, w2) of a point in the triangle's plane.
 fn barycentric(p: Vec3, tri: &RtTriangle) -> Vec3 {
     let (e1, e2, n, d) = (tri.e1, tri.e2, tri.n, p - tri.v0);

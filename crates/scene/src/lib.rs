@@ -16,12 +16,14 @@ mod light;
 mod material;
 mod mesh;
 mod obj;
+mod visibility;
 
 pub use builtin::BUILTIN_SCENES;
 pub use camera::{Camera, CameraRays};
 pub use light::{DistantLight, cone_cosine_integral};
 pub use material::{Ggx, Material};
 pub use mesh::{Mesh, normal_matrix};
+pub use visibility::Visibility;
 
 use glam::Vec3;
 

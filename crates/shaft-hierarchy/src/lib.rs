@@ -8,7 +8,6 @@
 //!   below 2 % of every reached vertex's radiance; per frame, [`ShaftHierarchy::traverse`] and
 //!   [`ShaftHierarchy::representatives`]; [`ShaftHierarchy::validate`] checks its invariants.
 //! - [`preprocess`]: the source set, receivers and transfers of a `real_scene::RealScene`.
-//! - [`measure`]: the object path, the brute-force conservativeness check, timing, overlay.
 //!
 //! Distant sources (the lights of an environment map) have no position: their end of a shaft
 //! is the receiver box moved `reach` along the light's cone of directions, so objects further
@@ -16,7 +15,6 @@
 
 mod aabb;
 mod hierarchy;
-pub mod measure;
 pub mod preprocess;
 mod shaft;
 mod tree;

@@ -3,11 +3,11 @@
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
-use shaft_hierarchy::measure::covered_pairs;
 use shaft_hierarchy::{
     Aabb, BuildError, Kind, Occlusion, Receiver, Settings, ShaftHierarchy, SourceShape, Transfers, Traversal,
     cone_directions,
 };
+use trade::shafts::covered_pairs;
 
 /// A distant source for sampling: its cone.
 #[derive(Clone, Copy)]

@@ -4,9 +4,9 @@
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
-use real_scene::{Patch, PatchBvh, Perturbation, RealScene, SolveSettings, luminance, solve};
-use shaft_hierarchy::measure::{check, object_path};
+use real_scene::{Patch, Perturbation, RealScene, SolveSettings, luminance, solve};
 use shaft_hierarchy::preprocess::{PreprocessSettings, Source, build, prepare};
+use trade::shafts::{check, object_path};
 
 fn patch(corners: [Vec3; 4], reflectance: f32, radiance: f32) -> Patch {
     Patch {
@@ -42,7 +42,7 @@ fn unoccluded_transfer_is_rho_l_times_the_form_factor() {
         environment_lit: false,
     };
     assert!(lamp.normal().y < 0.0, "the lamp faces the floor");
-    let bvh = PatchBvh::new(&scene);
+    let bvh = ref_tracer::SceneBvh::new(&scene.to_scene());
     let p = prepare(
         &scene,
         &[],
@@ -75,7 +75,7 @@ fn unoccluded_transfer_is_rho_l_times_the_form_factor() {
 #[test]
 fn source_set_is_the_powerful_prefix() {
     let mut scene = RealScene::builtin_with("ar_room", &Perturbation { coarsen: 2, ..Perturbation::NONE }).unwrap();
-    let bvh = PatchBvh::new(&scene);
+    let bvh = ref_tracer::SceneBvh::new(&scene.to_scene());
     solve(&mut scene, &bvh, None, &SolveSettings::default()).unwrap();
     for share in [0.3f32, 0.7, 1.0] {
         let p = prepare(&scene, &[], &bvh, &PreprocessSettings { source_share: share, ..PreprocessSettings::PAPER });
@@ -119,7 +119,7 @@ fn pipeline_misses_nothing_on_real_scenes() {
         .collect();
     for (name, lights) in [("ar_room", Vec::new()), ("ar_ground", lights)] {
         let mut scene = RealScene::builtin_with(name, &Perturbation { coarsen: 2, ..Perturbation::NONE }).unwrap();
-        let bvh = PatchBvh::new(&scene);
+        let bvh = ref_tracer::SceneBvh::new(&scene.to_scene());
         let env = scene.environment_lit.then_some(&map);
         solve(&mut scene, &bvh, env, &SolveSettings::default()).unwrap();
         let (prepared, h) = build(&scene, &lights, &bvh, &PreprocessSettings::PAPER).unwrap();
@@ -137,7 +137,7 @@ fn pipeline_misses_nothing_on_real_scenes() {
 #[test]
 fn preprocessing_is_deterministic() {
     let mut scene = RealScene::builtin_with("ar_room", &Perturbation { coarsen: 2, ..Perturbation::NONE }).unwrap();
-    let bvh = PatchBvh::new(&scene);
+    let bvh = ref_tracer::SceneBvh::new(&scene.to_scene());
     solve(&mut scene, &bvh, None, &SolveSettings::default()).unwrap();
     let (p1, h1) = build(&scene, &[], &bvh, &PreprocessSettings::PAPER).unwrap();
     let (p2, h2) = build(&scene, &[], &bvh, &PreprocessSettings::PAPER).unwrap();

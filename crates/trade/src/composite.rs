@@ -4,14 +4,16 @@
 //! measure); FLIP on the 8-bit images.
 
 use crate::TradeError;
+use crate::capture::PhotoSettings;
 use crate::front::Measurement;
 use crate::measure::Plan;
+use crate::session::{Session, SessionSettings};
 use crate::setting::{PatchMaps, Setting};
 use differential_composite::gpu::{GpuCompositor, GpuSettings};
-use differential_composite::{Mode, Session, SessionSettings, SyntheticObject, code_error};
+use differential_composite::{Mode, SyntheticObject, code_error};
 use glam::Vec3;
 use gpu::Gpu;
-use real_scene::{PhotoSettings, RealScene};
+use real_scene::RealScene;
 use ref_tracer::metrics::flip_rgb8;
 
 /// Where the sphere sits, from the scene's floor centre: `ar_ground`'s in front of the boxes
@@ -45,7 +47,7 @@ impl CompositeCase {
     pub fn new(gpu: &Gpu, scene_name: &str, method: &str, plan: &Plan) -> Result<Self, TradeError> {
         let e = |e: differential_composite::CompositeError| TradeError::Scene(format!("{scene_name}: {e}"));
         let real = RealScene::builtin(scene_name).map_err(|e| TradeError::Scene(e.to_string()))?;
-        let (map, lights) = differential_composite::setup::environment(&real, method, 32).map_err(e)?;
+        let (map, lights) = crate::session::environment(&real, method, 32).map_err(e)?;
         let map_name = if map.is_some() { envmap_sphere::DEFAULT_MAP_NAME.to_string() } else { "-".to_string() };
         let photo = PhotoSettings { spp: plan.photo_spp.max(1), ..SessionSettings::default().photo };
         let settings = SessionSettings { size: Some(plan.size), photo, ..SessionSettings::default() };
@@ -97,7 +99,7 @@ pub fn measure_composite(
             let frame = c.frame(&case.object, setting.passes);
             case.compositor.composite(gpu, c, &frame, &case.object, mode, &gpu_settings)?;
         }
-        let row = differential_composite::measure::rows(
+        let row = crate::composite_rows::rows(
             gpu,
             &case.compositor,
             &case.session,

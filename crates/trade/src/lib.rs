@@ -18,20 +18,27 @@
 //! no printing, progress goes to a callback.
 
 pub mod banding;
+pub mod capture;
 pub mod composite;
+pub mod composite_rows;
 pub mod front;
 pub mod measure;
+pub mod offline;
 pub mod point;
 pub mod report;
+pub mod session;
 pub mod setting;
+pub mod shafts;
 pub mod shard;
 pub mod table;
 
 pub use banding::{BandingCase, BandingRow, Interleave, measure_banding};
+pub use capture::{PhotoSettings, photograph, photograph_with};
 pub use composite::{CompositeCase, measure_composite};
 pub use front::{ChooseError, Measurement, Point, choose, front as pareto_front, mark_fronts, overall, pareto};
 pub use measure::{Case, Passes, Plan, measure};
 pub use point::{PointCase, measure_point};
+pub use session::{Session, SessionSettings};
 pub use setting::{CompositeSetting, EnvSetting, Family, PatchMaps, PointSetting, Preset, Setting, Shadow};
 pub use shard::{Shard, ShardError};
 pub use table::{Run, RunConfig, merge};

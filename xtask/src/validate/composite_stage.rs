@@ -7,11 +7,12 @@ use std::fmt::Write as _;
 
 use crate::common::WritePng;
 use differential_composite::gpu::{GpuCompositor, GpuSettings};
-use differential_composite::measure::{Row, figure3_datasets, rows};
-use differential_composite::{CodeError, Mode, Session, SessionSettings, code_error};
+use differential_composite::{CodeError, Mode, code_error};
 use glam::Vec3;
 use gpu::Gpu;
-use real_scene::{PhotoSettings, RealScene};
+use real_scene::RealScene;
+use trade::composite_rows::{Row, figure3_datasets, rows};
+use trade::{PhotoSettings, Session, SessionSettings};
 
 /// Where the sphere sits, from the floor's centre: on the ground in front of the boxes.
 const AT: Vec3 = Vec3::new(0.0, 0.3, 1.0);

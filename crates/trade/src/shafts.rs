@@ -10,8 +10,8 @@ use rand_pcg::Pcg64;
 use real_scene::{RealScene, Visibility, luminance};
 use scene::DistantLight;
 
-use crate::preprocess::{Prepared, Source};
-use crate::{Aabb, BuildError, Occlusion, ShaftHierarchy, Traversal};
+use shaft_hierarchy::preprocess::{Prepared, Source};
+use shaft_hierarchy::{Aabb, BuildError, Occlusion, ShaftHierarchy, Traversal};
 
 /// A box a tenth of the scene's width flying a loop through it, `frames` positions: around
 /// the scene's centre at 35 % of its width and depth, bobbing between 5 % and 55 % of its
@@ -281,11 +281,11 @@ pub fn figures(
     scene: &RealScene,
     lights: &[DistantLight],
     vis: &impl Visibility,
-    settings: &crate::preprocess::PreprocessSettings,
+    settings: &shaft_hierarchy::preprocess::PreprocessSettings,
     (frames, per_frame, representatives): (usize, usize, usize),
 ) -> Result<(Figures, Prepared, ShaftHierarchy), BuildError> {
     let t = Instant::now();
-    let (prepared, h) = crate::preprocess::build(scene, lights, vis, settings)?;
+    let (prepared, h) = shaft_hierarchy::preprocess::build(scene, lights, vis, settings)?;
     let preprocess_s = t.elapsed().as_secs_f64();
     h.validate().map_err(BuildError::Broken)?;
     let objects = object_path(scene, frames);
@@ -310,8 +310,8 @@ pub fn figures(
 /// The knobs swept by `cargo xtask shafts --sweep`: the paper's setting, then one knob at a
 /// time (source share, receivers per leaf, pruning threshold).
 #[must_use]
-pub fn sweep() -> Vec<(String, crate::preprocess::PreprocessSettings)> {
-    use crate::preprocess::PreprocessSettings as P;
+pub fn sweep() -> Vec<(String, shaft_hierarchy::preprocess::PreprocessSettings)> {
+    use shaft_hierarchy::preprocess::PreprocessSettings as P;
     let paper = P::PAPER;
     let mut out = vec![("paper (70 %, 8 a leaf, 2 %)".to_string(), paper)];
     for share in [0.5, 0.9] {
@@ -320,13 +320,13 @@ pub fn sweep() -> Vec<(String, crate::preprocess::PreprocessSettings)> {
     for leaf in [4, 16] {
         out.push((
             format!("{leaf} receivers a leaf"),
-            P { hierarchy: crate::Settings { leaf_size: leaf, ..paper.hierarchy }, ..paper },
+            P { hierarchy: shaft_hierarchy::Settings { leaf_size: leaf, ..paper.hierarchy }, ..paper },
         ));
     }
     for prune in [0.0, 0.1] {
         out.push((
             format!("pruning {:.0} %", prune * 100.0),
-            P { hierarchy: crate::Settings { prune_fraction: prune, ..paper.hierarchy }, ..paper },
+            P { hierarchy: shaft_hierarchy::Settings { prune_fraction: prune, ..paper.hierarchy }, ..paper },
         ));
     }
     out

@@ -3,11 +3,12 @@
 //! rendering with the reconstructed model: L_final = L_photo + L_obj - L_noobj outside the
 //! object, L_obj on it.
 
+use differential_composite::{CompositeError, SyntheticObject};
 use envmap_sphere::EnvMap;
 use glam::Vec3;
-use real_scene::{PhotoSettings, RealScene, photograph, photograph_with};
+use real_scene::RealScene;
 
-use crate::{CompositeError, SyntheticObject};
+use crate::capture::{PhotoSettings, photograph, photograph_with};
 
 /// The real scene photographed with `object` in it (HDR, row-major).
 ///

@@ -6,10 +6,12 @@ use std::time::Duration;
 
 use gpu::{Gpu, GpuError};
 
-use crate::compositor::Frame;
-use crate::gpu::{FrameTimes, GpuCompositor, GpuSettings, MapWork};
-use crate::ldr::Dataset;
-use crate::{CodeError, Mode, Session, SyntheticObject, code_error};
+use differential_composite::compositor::Frame;
+use differential_composite::gpu::{FrameTimes, GpuCompositor, GpuSettings, MapWork};
+use differential_composite::ldr::Dataset;
+use differential_composite::{CodeError, Mode, SyntheticObject, code_error};
+
+use crate::session::Session;
 
 /// One setting's figures.
 #[derive(Clone, Debug)]

@@ -2,16 +2,15 @@
 //! capture), its reconstruction solved and pre-processed (what the compositor knows), and the
 //! truth and Debevec's render for an object there.
 
+use differential_composite::{CompositeError, Compositor, SyntheticObject};
 use envmap_sphere::EnvMap;
 use glam::Vec3;
-use real_scene::{
-    CameraResponse, PatchBvh, Perturbation, PhotoSettings, RealScene, SolveSettings, estimate_reflectances, photograph,
-    solve,
-};
+use real_scene::{CameraResponse, Perturbation, RealScene, SolveSettings, estimate_reflectances, solve};
+use ref_tracer::SceneBvh;
 use scene::DistantLight;
 use shaft_hierarchy::preprocess::{PreprocessSettings, build};
 
-use crate::{CompositeError, Compositor, SyntheticObject};
+use crate::capture::{PhotoSettings, photograph};
 
 /// Knobs of a session.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -101,12 +100,12 @@ impl Session {
         };
         let mut real = sized(RealScene::builtin(name)?)?;
         let solve_settings = SolveSettings::default();
-        let real_bvh = PatchBvh::new(&real);
+        let real_bvh = SceneBvh::new(&real.to_scene());
         solve(&mut real, &real_bvh, map.as_ref(), &solve_settings)?;
         let photo = photograph(&real, map.as_ref(), &settings.photo)?.color;
         let response = CameraResponse::auto(&photo);
         let mut model = sized(RealScene::builtin_with(name, &settings.reconstruction)?)?;
-        let model_bvh = PatchBvh::new(&model);
+        let model_bvh = SceneBvh::new(&model.to_scene());
         if settings.estimate_reflectances {
             if model.patches.len() != real.patches.len() {
                 return Err(CompositeError::Parameter(
@@ -121,7 +120,9 @@ impl Session {
             solve(&mut model, &model_bvh, map.as_ref(), &solve_settings)?;
         }
         let built = build(&model, &lights, &model_bvh, &settings.preprocess)?;
-        let compositor = Compositor::new(model, lights, map.clone(), built, photo, response)?;
+        // the compositor's own ray queries, against the model as solved
+        let model_rays = Box::new(SceneBvh::new(&model.to_scene()));
+        let compositor = Compositor::new(model, lights, map.clone(), built, photo, response, model_rays)?;
         Ok(Self { real, map, compositor, settings: *settings })
     }
 
