@@ -5,13 +5,14 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use gpu::{Gpu, ShadowGeometry, scene_triangles};
-use shadowmap_paraboloid::{ShadowLight, ShadowMapper, equal_texel_variants, shadow_triangles};
+use shadowmap_paraboloid::{MapView, ShadowMapper, shadow_triangles};
+use trade::equal_texel_variants;
 
 fn shadow_maps(c: &mut Criterion) {
     let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
     let scene = scene::Scene::builtin("room").unwrap_or_else(|e| panic!("{e}"));
     let triangles = scene_triangles(&scene);
-    let light = ShadowLight::omni(scene.point_lights[0].position);
+    let light = MapView::omni(scene.point_lights[0].position);
     let mapper = ShadowMapper::new(&gpu);
     let mut group = c.benchmark_group("shadow_maps_room");
     for v in equal_texel_variants() {

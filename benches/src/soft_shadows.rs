@@ -10,12 +10,14 @@
 
 use glam::Vec3;
 use gpu::{
-    GBufferPass, Gpu, GpuError, LightShape, Receivers, SceneGeometry, ShadowTechnique, Visibility, render_visibility,
+    GBufferPass, Gpu, GpuError, LightShape, Receivers, SceneGeometry, ShadowTechnique, VisibilityLayers,
+    render_visibility,
 };
-use penumbra_wedge::{WedgePath, WedgeSettings, Wedges};
+use penumbra_wedge::{WedgePath, WedgeSettings};
 use ref_tracer::SceneBvh;
-use ref_tracer::visibility::{AreaLight, Weighting, area_light_visibility_refined};
-use shadowmap_paraboloid::{MapTechnique, Pcss, ShadowSettings, Technique};
+use ref_tracer::visibility::{Weighting, area_light_visibility_refined};
+use shadowmap_paraboloid::{Pcss, ShadowSettings};
+use trade::{TechniqueBuilder, TechniqueSpec};
 
 /// Paper 000's scenes and the validation scene.
 pub const SCENES: [&str; 3] = ["three_boxes", "column", "spheres_box"];
@@ -48,29 +50,25 @@ pub struct Entry {
 /// GPU failures.
 pub fn entries(gpu: &Gpu, scene: &scene::Scene) -> Result<Vec<Entry>, GpuError> {
     let hard = ShadowSettings { resolution: 2048, pcf_radius: 1, ..ShadowSettings::default() };
-    let maps = MapTechnique::new(gpu, scene, Technique::Orthographic, hard, 1)?;
-    let map = |settings: ShadowSettings, n: u32| Box::new(maps.variant(Technique::Orthographic, settings, n));
     // the covered fraction, unweighted, as the truth here is (`Weighting::Uniform`): the
     // techniques are compared on the same measure
     let wedges = WedgeSettings { cosine_weighted: false, ..WedgeSettings::default() };
-    let mut out = vec![
-        Entry { family: "wedges", technique: Box::new(Wedges::new(gpu, scene, wedges)) },
-        Entry {
-            family: "wedges_compute",
-            technique: Box::new(Wedges::new(gpu, scene, WedgeSettings { path: WedgePath::Compute, ..wedges })),
-        },
-        Entry { family: "shadow_maps", technique: map(hard, 1) },
+    let mut specs = vec![
+        ("wedges", TechniqueSpec::Wedges(wedges)),
+        ("wedges_compute", TechniqueSpec::Wedges(WedgeSettings { path: WedgePath::Compute, ..wedges })),
+        ("shadow_maps", TechniqueSpec::orthographic(hard, 1)),
     ];
     for filter_samples in [8, 32, 64] {
         let pcss = Pcss { filter_samples, blocker_samples: filter_samples.min(16), ..Pcss::default() };
-        let settings = ShadowSettings { pcf_radius: 0, pcss: Some(pcss), ..hard };
-        out.push(Entry { family: "pcss", technique: map(settings, 1) });
+        specs
+            .push(("pcss", TechniqueSpec::orthographic(ShadowSettings { pcf_radius: 0, pcss: Some(pcss), ..hard }, 1)));
     }
     for n in [4, 16, 64] {
         let settings = ShadowSettings { resolution: 1024, pcf_radius: 0, ..hard };
-        out.push(Entry { family: "shadow_maps_xN", technique: map(settings, n) });
+        specs.push(("shadow_maps_xN", TechniqueSpec::orthographic(settings, n)));
     }
-    Ok(out)
+    let built = TechniqueBuilder::new(gpu, scene).build_all(&specs)?;
+    Ok(built.into_iter().map(|(family, technique)| Entry { family, technique }).collect())
 }
 
 /// One measurement.
@@ -126,14 +124,10 @@ impl Frame {
     #[must_use]
     pub fn truth(&self, light: &LightShape) -> Vec<Option<f32>> {
         let bvh = SceneBvh::new(&self.scene);
-        let area = match *light {
-            LightShape::Distant { direction, half_angle } => AreaLight::Cone { direction, half_angle },
-            LightShape::Sphere { center, radius } => AreaLight::Sphere { center, radius },
-        };
         area_light_visibility_refined(
             &bvh,
             &self.points,
-            area,
+            *light,
             self.scene.camera.width as usize,
             (6, 32),
             Weighting::Uniform,
@@ -151,7 +145,7 @@ impl Frame {
         light: &LightShape,
     ) -> Result<(Vec<f32>, gpu::ShadowPassReport), GpuError> {
         let (w, h) = self.gbuffer.size();
-        let vis = Visibility::new(gpu, w, h, 1)?;
+        let vis = VisibilityLayers::new(gpu, w, h, 1)?;
         let receivers = Receivers::new(&self.gbuffer, &self.points);
         let report = render_visibility(gpu, technique, &receivers, std::slice::from_ref(light), &[], &vis)?.remove(0);
         Ok((vis.read(gpu, 0)?, report))

@@ -7,7 +7,9 @@
 use envmap_sphere::EnvMap;
 use envshadow_benches::decomposition::Frame;
 use glam::Vec3;
-use gpu::{GBufferPass, Gpu, LightShape, Receivers, SceneGeometry, ShadowTechnique, Visibility, render_visibility};
+use gpu::{
+    GBufferPass, Gpu, LightShape, Receivers, SceneGeometry, ShadowTechnique, VisibilityLayers, render_visibility,
+};
 use penumbra_wedge::{WedgePath, WedgeSettings, Wedges};
 use shadowmap_paraboloid::{MapTechnique, ShadowSettings, Technique};
 
@@ -57,7 +59,7 @@ fn layers(gpu: &Gpu) -> Vec<(String, Vec<Vec<f32>>)> {
     techniques
         .into_iter()
         .map(|(t, lights)| {
-            let vis = Visibility::new(gpu, 96, 72, lights.len() as u32).unwrap();
+            let vis = VisibilityLayers::new(gpu, 96, 72, lights.len() as u32).unwrap();
             render_visibility(gpu, t.as_ref(), &receivers, lights, &[], &vis).unwrap();
             (t.name(), (0..lights.len() as u32).map(|k| vis.read(gpu, k).unwrap()).collect())
         })

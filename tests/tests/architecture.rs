@@ -159,28 +159,37 @@ fn library_crates_reach_no_harness() {
 
 #[test]
 fn the_trade_meets_techniques_only_through_the_trait() {
-    // `trade` builds each technique from its `Shadow` value in one function and otherwise sees
-    // only `gpu::ShadowTechnique`; nothing of the techniques leaks into the fronts, the
-    // chooser, shards, tables or the report
+    // One technique builder (`trade::TechniqueBuilder`) makes every technique the trade,
+    // validate and the benches measure; otherwise they see only `gpu::ShadowTechnique`, and
+    // nothing of the techniques leaks into the fronts, the chooser, shards, tables or the report
     let graph = dependency_graph();
     let deps = transitive(&graph, "trade");
     assert!(deps.contains("gpu") && deps.contains("penumbra-wedge"), "trade's graph is incomplete: {deps:?}");
     assert!(!deps.contains("xtask"), "trade depends on xtask");
-    let dir = workspace_tests::workspace_root().join("crates/trade/src");
-    let mut builders = 0;
-    for entry in std::fs::read_dir(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display())) {
-        let path = entry.expect("dir entry").path();
-        let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        let name = path.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
+    let root = workspace_tests::workspace_root();
+    let mut files = Vec::new();
+    for dir in ["crates/trade/src", "xtask/src", "benches/src"] {
+        workspace_tests::collect(&root.join(dir), "rs", &mut files);
+    }
+    assert!(files.len() > 20, "found only {} harness files", files.len());
+    let mut builders = Vec::new();
+    for path in &files {
+        let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let rel = path.strip_prefix(&root).unwrap_or(path).to_string_lossy().replace('\\', "/");
         let named = ["Wedges::new", "MapTechnique::new"].iter().filter(|t| text.contains(*t)).count();
-        if name == "measure.rs" {
-            builders += named;
-        } else {
-            assert_eq!(named, 0, "{name} builds a technique");
-            assert!(!text.contains("penumbra_wedge"), "{name} names penumbra_wedge");
+        if named > 0 {
+            builders.push((rel.clone(), named));
+        }
+        let knobs = ["crates/trade/src/techniques.rs", "crates/trade/src/setting.rs"];
+        if rel.starts_with("crates/trade/") && !knobs.contains(&rel.as_str()) {
+            assert!(!text.contains("penumbra_wedge"), "{rel} names penumbra_wedge");
         }
     }
-    assert_eq!(builders, 2, "measure.rs builds wedges and maps in `technique`");
+    // the builder; and the animated frame, which moves its own maps and wedges
+    // (`set_transform` needs the concrete types)
+    let want = vec![("benches/src/decomposition.rs".to_string(), 2), ("crates/trade/src/techniques.rs".to_string(), 2)];
+    builders.sort();
+    assert_eq!(builders, want, "techniques built outside the one builder");
 }
 
 /// The module names `text` uses through `prefix` (`crate::` or `super::`), among `names`.

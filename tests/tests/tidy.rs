@@ -149,3 +149,65 @@ fn no_library_crate_reads_the_repositorys_folders() {
     }
     assert!(hits.is_empty(), "library sources that read the repository's folders:\n{}", hits.join("\n"));
 }
+
+/// `pub struct|enum|trait|type NAME` in each library crate's `src`, as (crate, name, file).
+fn public_types() -> Vec<(String, String, String)> {
+    let root = workspace_root();
+    let mut out = Vec::new();
+    for entry in std::fs::read_dir(root.join("crates")).expect("read crates/").flatten() {
+        let krate = entry.file_name().to_string_lossy().into_owned();
+        let mut files = Vec::new();
+        workspace_tests::collect(&entry.path().join("src"), "rs", &mut files);
+        for f in files {
+            let text = std::fs::read_to_string(&f).unwrap_or_default();
+            for line in text.lines() {
+                for kind in ["pub struct ", "pub enum ", "pub trait ", "pub type "] {
+                    if let Some(rest) = line.strip_prefix(kind) {
+                        let name: String = rest.chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
+                        out.push((krate.clone(), name, f.display().to_string()));
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn no_public_type_name_is_defined_twice() {
+    // One type per concept, and distinct names for distinct things: two library types of one
+    // name are either one concept written twice or two concepts a reader will confuse.
+    let types = public_types();
+    assert!(types.len() > 50, "found only {} public types", types.len());
+    let mut seen: std::collections::BTreeMap<&str, Vec<&str>> = std::collections::BTreeMap::new();
+    for (_, name, file) in &types {
+        seen.entry(name).or_default().push(file);
+    }
+    let twice: Vec<String> =
+        seen.iter().filter(|(_, f)| f.len() > 1).map(|(n, f)| format!("{n}: {}", f.join(", "))).collect();
+    assert!(twice.is_empty(), "public types defined more than once:\n{}", twice.join("\n"));
+}
+
+#[test]
+fn what_a_light_is_lives_in_scene_and_one_paraboloid_mapping_in_envmap_sphere() {
+    // A light's shape, power and colour are `scene`'s (`DistantLight`, `PointLight`,
+    // `LightShape`); other crates derive how they draw it. Named after a light, but not one:
+    // the shading pass's drawing data, an extraction result that holds a `scene::DistantLight`
+    // with what the extractor knows of it, and the environment map as the tracer's emitter.
+    let allowed = [("gpu", "ShadeLight"), ("light-extract", "ExtractedLight"), ("ref-tracer", "EnvLight")];
+    let types = public_types();
+    let lights: Vec<String> = types
+        .iter()
+        .filter(|(k, n, _)| n.ends_with("Light") && k != "scene" && !allowed.contains(&(k.as_str(), n.as_str())))
+        .map(|(_, n, f)| format!("{n} in {f}"))
+        .collect();
+    assert!(lights.is_empty(), "light types outside `scene`:\n{}", lights.join("\n"));
+    for name in ["DistantLight", "PointLight", "LightShape"] {
+        assert!(types.iter().any(|(k, n, _)| k == "scene" && n == name), "`scene` lost {name}");
+    }
+    let hemispheres: Vec<&String> = types.iter().filter(|(_, n, _)| n == "Hemisphere").map(|(_, _, f)| f).collect();
+    assert!(
+        hemispheres.len() == 1 && hemispheres[0].ends_with("envmap-sphere/src/paraboloid.rs"),
+        "the paraboloid mapping's Hemisphere is defined in {hemispheres:?}"
+    );
+}

@@ -41,7 +41,7 @@ pub fn run(scenes: &[String], size: (u32, u32), adapter: Option<&str>, out: &Pat
         );
     }
     let mut md = format!(
-        "Visibility error against ray-traced visibility, weighted by the light's unshadowed irradiance there relative to a surface facing it (mean and 95th percentile over pixels in or near penumbrae), and GPU time per light (median of 3), {}x{}, {}.\n\n| scene | half-angle | technique | mean | p95 | ms/light |\n|---|---|---|---|---|---|\n",
+        "VisibilityLayers error against ray-traced visibility, weighted by the light's unshadowed irradiance there relative to a surface facing it (mean and 95th percentile over pixels in or near penumbrae), and GPU time per light (median of 3), {}x{}, {}.\n\n| scene | half-angle | technique | mean | p95 | ms/light |\n|---|---|---|---|---|---|\n",
         size.0,
         size.1,
         gpu.describe()

@@ -91,7 +91,7 @@ pub struct RepTransfer {
 
 /// A frame's transfers.
 #[derive(Clone, Debug, Default)]
-pub struct Frame {
+pub struct FrameTransfers {
     /// Representatives, in decreasing transfer.
     pub reps: Vec<RepTransfer>,
     /// Sources the traversal reported.
@@ -108,7 +108,7 @@ pub struct Frame {
     pub object_irradiance: Sh9,
 }
 
-impl Frame {
+impl FrameTransfers {
     /// The frame's CPU work: traversal, transfers and the object's irradiance probe.
     #[must_use]
     pub fn cpu(&self) -> Duration {
@@ -201,7 +201,7 @@ impl Compositor {
     /// A frame for `object`: traversal, `passes` representatives (0: one per occluded source),
     /// and their transfers.
     #[must_use]
-    pub fn frame(&self, object: &SyntheticObject, passes: usize) -> Frame {
+    pub fn frame(&self, object: &SyntheticObject, passes: usize) -> FrameTransfers {
         let t = Instant::now();
         let mut scratch = Traversal::default();
         let mut occlusion = Occlusion::default();
@@ -247,7 +247,7 @@ impl Compositor {
         let transfers = t.elapsed();
         let t = Instant::now();
         let object_irradiance = self.irradiance_at(object.centre);
-        Frame {
+        FrameTransfers {
             reps: out,
             occluded_sources: occlusion.sources.len(),
             occluded_receivers: occlusion.receivers.len(),

@@ -8,7 +8,7 @@ use rayon::prelude::*;
 use real_scene::Visibility;
 use shaft_hierarchy::preprocess::Origin;
 
-use crate::compositor::{Compositor, Frame};
+use crate::compositor::{Compositor, FrameTransfers};
 use crate::{Mode, SyntheticObject};
 
 /// An object's ray queries: against the shaded mesh (what the camera sees) and the
@@ -70,7 +70,13 @@ const COVERAGE: [(f32, f32); 4] = [(0.375, 0.125), (0.875, 0.375), (0.625, 0.875
 /// blended by its coverage, the rest the photograph less each representative's transfer where
 /// the object blocks the representative's origin.
 #[must_use]
-pub fn composite(c: &Compositor, frame: &Frame, object: &SyntheticObject, bvh: &ObjectBvh, mode: Mode) -> Vec<[u8; 3]> {
+pub fn composite(
+    c: &Compositor,
+    frame: &FrameTransfers,
+    object: &SyntheticObject,
+    bvh: &ObjectBvh,
+    mode: Mode,
+) -> Vec<[u8; 3]> {
     let (w, h) = c.size;
     let rays = c.model.camera.rays();
     let eps = c.model_bvh().epsilon();

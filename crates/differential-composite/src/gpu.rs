@@ -16,10 +16,10 @@ use std::time::{Duration, Instant};
 
 use glam::Vec3;
 use gpu::{GBuffer, GBufferPass, Gpu, GpuError, SceneGeometry, ShadowGeometry};
-use shadowmap_paraboloid::{DEPTH_FORMAT, ShadowLight, ShadowMapper, ShadowSettings, Technique};
+use shadowmap_paraboloid::{DEPTH_FORMAT, MapView, ShadowMapper, ShadowSettings, Technique};
 use shaft_hierarchy::preprocess::{Origin, Source};
 
-use crate::compositor::{Compositor, Frame, RepTransfer};
+use crate::compositor::{Compositor, FrameTransfers, RepTransfer};
 use crate::{Mode, SyntheticObject};
 
 /// Knobs of the GPU compositor.
@@ -49,17 +49,17 @@ impl GpuSettings {
     /// paraboloid (or a cube), an omnidirectional paraboloid from a point on a distant source, an
     /// orthographic map along a direction.
     #[must_use]
-    pub fn map_light(&self, c: &Compositor, r: &RepTransfer) -> (ShadowLight, Technique) {
+    pub fn map_light(&self, c: &Compositor, r: &RepTransfer) -> (MapView, Technique) {
         match (r.origin, c.prepared.sources[r.origin_source as usize]) {
             (Origin::Point(p), Source::Patch(_)) if self.patch_maps == Technique::Cube => {
-                (ShadowLight::omni(p), Technique::Cube)
+                (MapView::omni(p), Technique::Cube)
             }
             (Origin::Point(p), Source::Patch(j)) => {
                 let n = c.model.patches[j as usize].normal();
-                (ShadowLight::Point { position: p, hemisphere: Some(n) }, Technique::DualParaboloid)
+                (MapView::Point { position: p, hemisphere: Some(n) }, Technique::DualParaboloid)
             }
-            (Origin::Point(p), Source::Distant(_)) => (ShadowLight::omni(p), Technique::DualParaboloid),
-            (Origin::Direction(d), _) => (ShadowLight::Distant { direction: d }, Technique::Orthographic),
+            (Origin::Point(p), Source::Distant(_)) => (MapView::omni(p), Technique::DualParaboloid),
+            (Origin::Direction(d), _) => (MapView::Distant { direction: d }, Technique::Orthographic),
         }
     }
 }
@@ -225,7 +225,7 @@ impl GpuCompositor {
         &self,
         gpu: &Gpu,
         c: &Compositor,
-        frame: &Frame,
+        frame: &FrameTransfers,
         object: &SyntheticObject,
         mode: Mode,
         settings: &GpuSettings,
@@ -277,7 +277,7 @@ impl GpuCompositor {
         gpu: &Gpu,
         encoder: &mut wgpu::CommandEncoder,
         c: &Compositor,
-        frame: &Frame,
+        frame: &FrameTransfers,
         object: &SyntheticObject,
         mode: Mode,
         settings: &GpuSettings,
@@ -325,7 +325,7 @@ impl GpuCompositor {
         gpu: &Gpu,
         encoder: &mut wgpu::CommandEncoder,
         c: &Compositor,
-        frame: &Frame,
+        frame: &FrameTransfers,
         object: &SyntheticObject,
         settings: &GpuSettings,
     ) -> Result<Maps, GpuError> {
@@ -340,7 +340,7 @@ impl GpuCompositor {
             subdivide_angle: None,
             ..ShadowSettings::default()
         };
-        let lights: Vec<(ShadowLight, Technique)> = frame.reps.iter().map(|r| settings.map_light(c, r)).collect();
+        let lights: Vec<(MapView, Technique)> = frame.reps.iter().map(|r| settings.map_light(c, r)).collect();
         let limit = gpu.device.limits().max_texture_array_layers;
         let views: Vec<u32> = lights.iter().map(|(l, t)| ShadowMapper::view_count(l, *t)).collect();
         let batches = batches(&views, settings.layers_per_array.map_or(limit, |n| n.min(limit)));
@@ -369,7 +369,7 @@ impl GpuCompositor {
                 work.views += map.views.len() as u32;
                 // a hemispherical light's paraboloid map has its front view alone
                 if map.technique == Technique::DualParaboloid
-                    && matches!(light, ShadowLight::Point { hemisphere: Some(_), .. })
+                    && matches!(light, MapView::Point { hemisphere: Some(_), .. })
                 {
                     work.hemispheres_skipped += 2 - map.views.len() as u32;
                 }
@@ -387,7 +387,7 @@ impl GpuCompositor {
         gpu: &Gpu,
         encoder: &mut wgpu::CommandEncoder,
         c: &Compositor,
-        frame: &Frame,
+        frame: &FrameTransfers,
         mode: Mode,
         gb: &GBuffer,
         maps: &Maps,
@@ -459,7 +459,7 @@ impl GpuCompositor {
         encoder: &mut wgpu::CommandEncoder,
         c: &Compositor,
         gb: &GBuffer,
-        frame: &Frame,
+        frame: &FrameTransfers,
         object: &SyntheticObject,
         mode: Mode,
     ) {

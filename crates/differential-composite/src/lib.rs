@@ -26,7 +26,7 @@ pub mod ldr;
 pub mod metrics;
 pub mod object;
 
-pub use compositor::{Compositor, Frame, PixelRef, RepTransfer};
+pub use compositor::{Compositor, FrameTransfers, PixelRef, RepTransfer};
 pub use metrics::{CodeError, code_error};
 pub use object::{BUILTIN_OBJECTS, SyntheticObject};
 

@@ -6,7 +6,7 @@ use std::sync::OnceLock;
 
 use differential_composite::cpu::{ObjectBvh, composite, object_pixels};
 use differential_composite::gpu::{GpuCompositor, GpuSettings};
-use differential_composite::{Compositor, Frame, Mode, SyntheticObject};
+use differential_composite::{Compositor, FrameTransfers, Mode, SyntheticObject};
 use glam::Vec3;
 use real_scene::{Perturbation, luminance};
 use trade::{PhotoSettings, Session, SessionSettings};
@@ -49,12 +49,12 @@ fn sphere(s: &Session, at: Vec3) -> SyntheticObject {
     s.object("sphere", at).unwrap_or_else(|e| panic!("{e}"))
 }
 
-fn cpu_composite(s: &Session, frame: &Frame, object: &SyntheticObject, mode: Mode) -> Vec<[u8; 3]> {
+fn cpu_composite(s: &Session, frame: &FrameTransfers, object: &SyntheticObject, mode: Mode) -> Vec<[u8; 3]> {
     let bvh = ObjectBvh::new(object, &object.mesh, s.compositor.model.camera, &rays);
     composite(&s.compositor, frame, object, &bvh, mode)
 }
 
-fn gpu_composite(frame: &Frame, object: &SyntheticObject, mode: Mode) -> Vec<[u8; 3]> {
+fn gpu_composite(frame: &FrameTransfers, object: &SyntheticObject, mode: Mode) -> Vec<[u8; 3]> {
     let (g, gc) = gpu();
     gc.composite(g, &room().compositor, frame, object, mode, &GpuSettings::default())
         .unwrap_or_else(|e| panic!("{e}"))

@@ -226,3 +226,20 @@ fn sphere_image_lookup_finds_what_was_resampled() {
         }
     }
 }
+
+#[test]
+fn back_map_is_the_front_turned_half_a_turn_about_y() {
+    // p = (-x, y) / (1 - z) on the back map: a rotation of the front's frame, so triangles keep
+    // their winding when a rasterizer draws into it (a shadow map's back map is this one).
+    for k in 0..200 {
+        let a = k as f32 * 2.399_963;
+        let z = -(k as f32 + 0.5) / 200.0;
+        let s = (1.0 - z * z).sqrt();
+        let d = Vec3::new(s * a.cos(), s * a.sin(), z);
+        let want = Vec2::new(-d.x, d.y) / (1.0 - d.z);
+        let p = paraboloid_dir_to_point(d, Hemisphere::Back);
+        assert!((p - want).length() < 1e-6, "{d}: {p} vs {want}");
+        let front = paraboloid_dir_to_point(Vec3::new(-d.x, d.y, -d.z), Hemisphere::Front);
+        assert!((p - front).length() < 1e-6);
+    }
+}

@@ -108,7 +108,7 @@ impl ResolvePass {
     pub fn with_shader(gpu: &Gpu, label: &str, source: &str, library: &[(&str, &str)]) -> Self {
         let module = crate::shader::module(&gpu.device, label, source, library);
         Self {
-            pipeline: crate::fullscreen::pipeline(gpu, label, &module, crate::shade::Visibility::FORMAT),
+            pipeline: crate::fullscreen::pipeline(gpu, label, &module, crate::shade::VisibilityLayers::FORMAT),
             slots: crate::Slots::new(),
         }
     }

@@ -26,8 +26,8 @@
 //! cone lights (the diffuse lobe by the cone's exact irradiance, `scene::cone_cosine_integral`; GGX
 //! by a representative point), point lights and SH9 ambient, with the map as `Background`; passes
 //! build their pipelines once and render per frame. The BRDF mirrors `scene::brdf` in
-//! `shaders/gpu/brdf.wgsl`. Each light's shadow arrives as one screen-space visibility layer
-//! (`Visibility`): the shading pass does not know how a shadow technique made it. The one interface
+//! `crates/gpu/shaders/brdf.wgsl`. Each light's shadow arrives as one screen-space visibility layer
+//! (`VisibilityLayers`): the shading pass does not know how a shadow technique made it. The one interface
 //! of shadow techniques lives here (`technique`): `ShadowTechnique::record(gpu, encoder, receivers,
 //! light, layer)` records a light's passes into the caller's encoder (no submission, wait or
 //! mapping; scratch targets reused from light to light); `LightShape` (distant cone or sphere) and
@@ -38,7 +38,7 @@
 //! each between GPU timestamps of its own, or an even share of its wall time without them; no light
 //! has a submission of its own); every pass has a `record` form (`GBufferPass::record`,
 //! `ShadingPass::record_texture`, `UpsamplePass::record`, `record_split`,
-//! `Visibility::record_clear`, `GBuffer::record_points`), an object moves by a transform
+//! `VisibilityLayers::record_clear`, `GBuffer::record_points`), an object moves by a transform
 //! (`SceneGeometry::set_transform`, `ShadowGeometry::set_transform`; `placement` places the
 //! object-space vertices on the GPU in the caller's encoder) or has its deformed vertices written
 //! in place (`SceneGeometry::update_object`, `ShadowGeometry::update`); `slots` keeps per-light
@@ -130,7 +130,7 @@ pub use readback::{
     MappingRead, PendingRead, read_buffer, read_mapped, read_mapped_all, read_texture_f32, read_texture_rgba,
 };
 pub use receivers::{MappedStats, PendingStats, ReceiverReduction, ReceiverStats, WeberInput};
-pub use shade::{Background, HDR_FORMAT, ShadeLight, ShadeParams, ShadingPass, Visibility, read_hdr};
+pub use shade::{Background, HDR_FORMAT, ShadeLight, ShadeParams, ShadingPass, VisibilityLayers, read_hdr};
 pub use slots::{Keyed, MAX_SLOTS_PER_SUBMISSION, Slots};
 pub use split::{SplitFrame, SplitImage, SplitPasses, SplitSettings, SplitTargets, indirect_camera, record_split};
 pub use supersample::RotatedGrid;

@@ -15,7 +15,7 @@ use crate::gbuffer::{GBuffer, GBufferPass, GBufferTargets};
 use crate::geometry::SceneGeometry;
 use crate::interleave::{InterleavePass, MAX_SETS};
 use crate::receivers::{MappedStats, PendingStats, ReceiverReduction, WeberInput};
-use crate::shade::{Background, ShadeLight, ShadeParams, ShadingPass, Visibility};
+use crate::shade::{Background, ShadeLight, ShadeParams, ShadingPass, VisibilityLayers};
 use crate::slots::Keyed;
 use crate::split::{SplitFrame, SplitPasses, SplitSettings, SplitTargets, indirect_size, record_split_stamped};
 use crate::technique::{
@@ -170,7 +170,7 @@ pub struct LitFrame {
     // per (scale, EnvIndirects): the low G-buffer and the split frame's images
     scales: RefCell<Keyed<(u32, u32), Rc<ScaleTargets>>>,
     // the EnvDirects' visibility, per layer count
-    direct_visibility: RefCell<Keyed<u32, Rc<Visibility>>>,
+    direct_visibility: RefCell<Keyed<u32, Rc<VisibilityLayers>>>,
     // a frame without EnvIndirects: its one shaded image
     whole: RefCell<Keyed<(u32, u32), wgpu::Texture>>,
     // interleaved light sets: the gathering pass and the gathered image
@@ -478,7 +478,7 @@ impl LitFrame {
         let vis = {
             let layers = (directs as u32).max(1);
             let mut cache = self.direct_visibility.borrow_mut();
-            cache.try_get(layers, || Visibility::allocate(gpu, size.0, size.1, layers).map(Rc::new))?.clone()
+            cache.try_get(layers, || VisibilityLayers::allocate(gpu, size.0, size.1, layers).map(Rc::new))?.clone()
         };
         vis.record_clear(&mut encoder);
         let stamps =

@@ -10,7 +10,9 @@ use envmap_sphere::{EnvMap, Sh9};
 use glam::Vec3;
 use wgpu::util::DeviceExt;
 
-/// A light as the shading pass sees it.
+/// How the shading pass draws a light: its drawing data, derived from what the light *is*
+/// (`From<&scene::DistantLight>`, `From<&scene::PointLight>`; a sphere light is shaded as the
+/// point at its centre, which is exact for a uniform sphere above a receiver's horizon).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ShadeLight {
     /// A distant cone light of uniform radiance: the diffuse lobe gets the cone's exact
@@ -66,12 +68,12 @@ pub struct ShadeParams<'a> {
 }
 
 /// One visibility layer per light, screen-sized, 1 = lit.
-pub struct Visibility {
+pub struct VisibilityLayers {
     /// R8Unorm 2D array.
     pub texture: wgpu::Texture,
 }
 
-impl Visibility {
+impl VisibilityLayers {
     /// Format of the layers.
     pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
 
@@ -88,7 +90,7 @@ impl Visibility {
     }
 
     /// `layers` layers of `width` × `height` (at least one), contents undefined until
-    /// [`Visibility::record_clear`] or a technique writes them.
+    /// [`VisibilityLayers::record_clear`] or a technique writes them.
     ///
     /// # Errors
     /// [`GpuError::TooLarge`] beyond the adapter's limits.
@@ -214,7 +216,7 @@ impl ShadingPass {
         geometry: &SceneGeometry,
         gbuffer: &GBuffer,
         params: &ShadeParams,
-        visibility: &Visibility,
+        visibility: &VisibilityLayers,
     ) -> Result<Vec<Vec3>, GpuError> {
         let output = self.render_texture(gpu, geometry, gbuffer, params, visibility)?;
         read_hdr(gpu, &output)
@@ -231,7 +233,7 @@ impl ShadingPass {
         geometry: &SceneGeometry,
         gbuffer: &GBuffer,
         params: &ShadeParams,
-        visibility: &Visibility,
+        visibility: &VisibilityLayers,
     ) -> Result<wgpu::Texture, GpuError> {
         let mut encoder = gpu.encoder("shade");
         let output = self.record_texture(gpu, &mut encoder, geometry, gbuffer, params, visibility)?;
@@ -251,7 +253,7 @@ impl ShadingPass {
         geometry: &SceneGeometry,
         gbuffer: &GBuffer,
         params: &ShadeParams,
-        visibility: &Visibility,
+        visibility: &VisibilityLayers,
     ) -> Result<wgpu::Texture, GpuError> {
         let (w, h) = gbuffer.size();
         let output = crate::target::render_target(gpu, "shaded", (w, h, 1), HDR_FORMAT)?;
@@ -275,7 +277,7 @@ impl ShadingPass {
         geometry: &SceneGeometry,
         gbuffer: &GBuffer,
         params: &ShadeParams,
-        visibility: &Visibility,
+        visibility: &VisibilityLayers,
         output: &wgpu::Texture,
     ) -> Result<(), GpuError> {
         let (w, h) = gbuffer.size();

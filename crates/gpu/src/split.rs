@@ -8,7 +8,7 @@ use crate::context::{Gpu, GpuError};
 use crate::gbuffer::GBufferPass;
 use crate::geometry::SceneGeometry;
 use crate::lit_frame::FrameLights;
-use crate::shade::{ShadeParams, ShadingPass, Visibility};
+use crate::shade::{ShadeParams, ShadingPass, VisibilityLayers};
 use crate::technique::{Receivers, ShadowPassReport, ShadowTechnique, WEBER_FRACTION, weber_negligible};
 use crate::upsample::{JointBilateral, UpsamplePass};
 
@@ -44,7 +44,7 @@ pub struct SplitFrame<'a> {
 /// rendered into them is overwritten by the next one.
 pub struct SplitTargets {
     base: wgpu::Texture,
-    indirect_visibility: Visibility,
+    indirect_visibility: VisibilityLayers,
     shaded: wgpu::Texture,
     output: wgpu::Texture,
 }
@@ -61,7 +61,7 @@ impl SplitTargets {
         let target = |label, (w, h)| crate::target::render_target(gpu, label, (w, h, 1), crate::shade::HDR_FORMAT);
         Ok(Self {
             base: target("split base", size)?,
-            indirect_visibility: Visibility::allocate(gpu, lw, lh, indirects)?,
+            indirect_visibility: VisibilityLayers::allocate(gpu, lw, lh, indirects)?,
             shaded: target("split indirects", (lw, lh))?,
             output: target("split frame", size)?,
         })
@@ -132,7 +132,7 @@ pub fn record_split(
     encoder: &mut wgpu::CommandEncoder,
     passes: &SplitPasses,
     geometry: &SceneGeometry,
-    (receivers, direct_visibility): (&Receivers, &Visibility),
+    (receivers, direct_visibility): (&Receivers, &VisibilityLayers),
     (low, low_negligible): (&Receivers, Option<&[bool]>),
     frame: &SplitFrame,
     indirect: &dyn ShadowTechnique,
@@ -161,7 +161,7 @@ pub(crate) fn record_split_stamped(
     encoder: &mut wgpu::CommandEncoder,
     passes: &SplitPasses,
     geometry: &SceneGeometry,
-    (receivers, direct_visibility): (&Receivers, &Visibility),
+    (receivers, direct_visibility): (&Receivers, &VisibilityLayers),
     (low, low_negligible): (&Receivers, Option<&[bool]>),
     frame: &SplitFrame,
     indirect: &dyn ShadowTechnique,

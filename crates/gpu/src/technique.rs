@@ -13,75 +13,12 @@
 use crate::context::{Gpu, GpuError};
 use crate::gate::{Gate, GpuStats};
 use crate::gbuffer::GBuffer;
-use crate::shade::Visibility;
+use crate::shade::VisibilityLayers;
 use crate::timer::Clock;
 use glam::Vec3;
 use std::time::Duration;
 
-/// A light as shadow techniques see it: where it is and how large, not its colour.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum LightShape {
-    /// A distant cone light (the extracted lights): the disk is the cone's cross-section.
-    Distant {
-        /// Unit direction towards the light (the cone's axis).
-        direction: Vec3,
-        /// Half-angle of the cone, radians, in [0, pi/2).
-        half_angle: f32,
-    },
-    /// A local spherical light; radius 0 is a point light.
-    Sphere {
-        /// Centre, metres.
-        center: Vec3,
-        /// Radius, metres.
-        radius: f32,
-    },
-}
-
-impl LightShape {
-    /// The largest half-angle techniques accept: wider cones are clamped to it (a cone of
-    /// 90 degrees or more has no disk cross-section).
-    pub const MAX_HALF_ANGLE: f32 = 1.5;
-
-    /// Half-angle the light subtends from `p` (0 for a point light; pi/2 inside a sphere light).
-    #[must_use]
-    pub fn half_angle_at(&self, p: Vec3) -> f32 {
-        match *self {
-            LightShape::Distant { half_angle, .. } => half_angle.clamp(0.0, Self::MAX_HALF_ANGLE),
-            LightShape::Sphere { center, radius } => {
-                let d = center.distance(p);
-                if d <= radius { std::f32::consts::FRAC_PI_2 } else { (radius / d).asin() }
-            }
-        }
-    }
-
-    /// Unit direction from `p` to the light's centre.
-    #[must_use]
-    pub fn direction_from(&self, p: Vec3) -> Vec3 {
-        match *self {
-            LightShape::Distant { direction, .. } => direction.normalize_or(Vec3::Y),
-            LightShape::Sphere { center, .. } => (center - p).normalize_or(Vec3::Y),
-        }
-    }
-
-    /// Whether any part of the light is above the plane of a surface at `p` with normal `n`.
-    #[must_use]
-    pub fn reaches(&self, p: Vec3, n: Vec3) -> bool {
-        let d = self.direction_from(p);
-        n.dot(d) > -self.half_angle_at(p).sin()
-    }
-}
-
-impl From<&scene::DistantLight> for LightShape {
-    fn from(l: &scene::DistantLight) -> Self {
-        LightShape::Distant { direction: l.direction.normalize_or(Vec3::Y), half_angle: l.half_angle() }
-    }
-}
-
-impl From<&scene::PointLight> for LightShape {
-    fn from(l: &scene::PointLight) -> Self {
-        LightShape::Sphere { center: l.position, radius: 0.0 }
-    }
-}
+pub use scene::LightShape;
 
 /// What a frame gives shadow techniques: the G-buffer on the GPU and, on the CPU, the visible
 /// surface points (position, geometric normal; NaN positions for background pixels) with their
@@ -264,7 +201,7 @@ fn each_light(
     receivers: &Receivers,
     lights: &[LightShape],
     negligible: &[bool],
-    visibility: &Visibility,
+    visibility: &VisibilityLayers,
     mut shadow: impl FnMut(u32, &LightShape) -> Result<ShadowPassReport, GpuError>,
 ) -> Result<Vec<ShadowPassReport>, GpuError> {
     if lights.len() as u64 > u64::from(visibility.layers()) {
@@ -287,7 +224,7 @@ fn each_light(
 /// Records every light's layer of `visibility` with `technique` into `encoder`, skipping
 /// lights that no visible receiver faces and lights marked in `negligible` (e.g. by
 /// [`weber_negligible`]; an empty slice marks none). Skipped lights' layers are left as they
-/// are: clear `visibility` to lit first ([`Visibility::record_clear`]).
+/// are: clear `visibility` to lit first ([`VisibilityLayers::record_clear`]).
 ///
 /// # Errors
 /// [`GpuError::TooLarge`] when `visibility` has fewer layers than lights; the technique's
@@ -299,7 +236,7 @@ pub fn record_visibility(
     receivers: &Receivers,
     lights: &[LightShape],
     negligible: &[bool],
-    visibility: &Visibility,
+    visibility: &VisibilityLayers,
 ) -> Result<Vec<ShadowPassReport>, GpuError> {
     record_visibility_stamped(gpu, encoder, (technique, receivers), (lights, negligible), visibility, None)
 }
@@ -312,7 +249,7 @@ pub(crate) fn record_visibility_stamped(
     encoder: &mut wgpu::CommandEncoder,
     (technique, receivers): (&dyn ShadowTechnique, &Receivers),
     (lights, negligible): (&[LightShape], &[bool]),
-    visibility: &Visibility,
+    visibility: &VisibilityLayers,
     stamps: Option<(&LightStamps, usize)>,
 ) -> Result<Vec<ShadowPassReport>, GpuError> {
     let reports = each_light(receivers, lights, negligible, visibility, |k, light| {
@@ -433,7 +370,7 @@ pub fn render_visibility(
     receivers: &Receivers,
     lights: &[LightShape],
     negligible: &[bool],
-    visibility: &Visibility,
+    visibility: &VisibilityLayers,
 ) -> Result<Vec<ShadowPassReport>, GpuError> {
     if lights.is_empty() {
         return Ok(Vec::new());
@@ -615,7 +552,7 @@ impl PrecomputedVisibility {
             });
         }
         let module = crate::shader::module(&gpu.device, "upload", include_str!("../shaders/upload.wgsl"), &[]);
-        let pipeline = crate::fullscreen::pipeline(gpu, "upload", &module, Visibility::FORMAT);
+        let pipeline = crate::fullscreen::pipeline(gpu, "upload", &module, VisibilityLayers::FORMAT);
         let buffer = |label, contents: &[u8], usage| {
             gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
         };

@@ -7,7 +7,7 @@ use envmap_sphere::{EnvMap, Sh9};
 use glam::Vec3;
 use gpu::{
     Background, DfgTable, GBufferPass, Gpu, PrefilterSettings, PrefilteredMap, SceneGeometry, ShadeParams, ShadingPass,
-    SpecularAmbient, Visibility,
+    SpecularAmbient, VisibilityLayers,
 };
 use ref_tracer::{AmbientMap, Integrator, LightSet, RenderSettings, SceneBvh, render};
 use scene::{Camera, Ggx, Material, Mesh, Object, Scene};
@@ -120,7 +120,7 @@ fn ambient_images(scene: &Scene, map: &EnvMap) -> (Vec<Vec3>, Vec<Vec3>, Vec<u32
     let background = Background::upload(&gpu, map).unwrap();
     let geometry = SceneGeometry::upload(&gpu, scene).unwrap();
     let gb = GBufferPass::new(&gpu).render(&gpu, &geometry, &scene.camera).unwrap();
-    let vis = Visibility::new(&gpu, scene.camera.width, scene.camera.height, 1).unwrap();
+    let vis = VisibilityLayers::new(&gpu, scene.camera.width, scene.camera.height, 1).unwrap();
     let params = ShadeParams {
         lights: &[],
         ambient: Some(&sh),

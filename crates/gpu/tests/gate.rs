@@ -6,7 +6,7 @@
 use glam::Vec3;
 use gpu::{
     GBufferPass, Gpu, LightShape, PrecomputedVisibility, ReceiverReduction, Receivers, SceneGeometry, ShadeLight,
-    Visibility, WEBER_FRACTION, WeberInput,
+    VisibilityLayers, WEBER_FRACTION, WeberInput,
 };
 
 /// A sun from above, a sky of faint lights (the faintest under Weber's 2 %), one light from
@@ -54,7 +54,7 @@ fn gated_lights_draw_exactly_where_the_reduction_says_they_need_a_pass() {
     let layers = shapes.iter().map(|l| (*l, vec![0.25; pixels])).collect();
     let technique = PrecomputedVisibility::new(&gpu, "quarter", (64, 48), layers).unwrap();
     let reduction = ReceiverReduction::new(&gpu);
-    let vis = Visibility::allocate(&gpu, 64, 48, shapes.len() as u32).unwrap();
+    let vis = VisibilityLayers::allocate(&gpu, 64, 48, shapes.len() as u32).unwrap();
 
     let before = gpu.counters();
     let mut encoder = gpu.encoder("gated");
@@ -117,7 +117,7 @@ fn measured_lights_share_one_submission_each_with_its_own_time() {
         let shapes: Vec<LightShape> = lights().iter().map(shape).take(3).collect();
         let layers = shapes.iter().map(|l| (*l, vec![0.5; 32 * 24])).collect();
         let technique = PrecomputedVisibility::new(&gpu, "half", (32, 24), layers).unwrap();
-        let vis = Visibility::allocate(&gpu, 32, 24, shapes.len() as u32).unwrap();
+        let vis = VisibilityLayers::allocate(&gpu, 32, 24, shapes.len() as u32).unwrap();
         let before = gpu.counters();
         let reports = gpu::render_visibility(&gpu, &technique, &receivers, &shapes, &[], &vis).unwrap();
         let d = gpu.counters() - before;

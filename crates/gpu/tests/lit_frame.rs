@@ -6,7 +6,7 @@
 use glam::Vec3;
 use gpu::{
     FrameLights, FrameShadows, GBufferPass, Gpu, LightShape, LitFrame, LitSettings, PrecomputedVisibility, Receivers,
-    ReferenceReceivers, SceneGeometry, ShadeLight, ShadeParams, ShadingPass, Visibility, read_hdr,
+    ReferenceReceivers, SceneGeometry, ShadeLight, ShadeParams, ShadingPass, VisibilityLayers, read_hdr,
 };
 
 /// The ground alone: nothing visible faces a light from below.
@@ -70,9 +70,9 @@ fn the_recorded_frame_equals_its_passes_put_together() {
     let receivers = Receivers::new(&gb, &points);
     let params = ShadeParams { lights: &shade, ..Default::default() };
     let shading = ShadingPass::new(&gpu).unwrap();
-    let unlit = Visibility::new(&gpu, size.0, size.1, shade.len() as u32).unwrap();
+    let unlit = VisibilityLayers::new(&gpu, size.0, size.1, shade.len() as u32).unwrap();
     let plain = read_hdr(&gpu, &shading.render_texture(&gpu, &geometry, &gb, &params, &unlit).unwrap()).unwrap();
-    let vis = Visibility::new(&gpu, size.0, size.1, shade.len() as u32).unwrap();
+    let vis = VisibilityLayers::new(&gpu, size.0, size.1, shade.len() as u32).unwrap();
     let by_hand = gpu::render_visibility(&gpu, &technique, &receivers, &shapes, &[], &vis).unwrap();
     let shadowed = read_hdr(&gpu, &shading.render_texture(&gpu, &geometry, &gb, &params, &vis).unwrap()).unwrap();
     assert!(by_hand.iter().any(|r| r.skipped.is_some()) && by_hand.iter().any(|r| r.skipped.is_none()));

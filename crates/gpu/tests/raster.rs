@@ -4,7 +4,7 @@
 
 use envmap_sphere::{EnvMap, Sh9};
 use glam::Vec3;
-use gpu::{Background, GBufferPass, Gpu, SceneGeometry, ShadeLight, ShadeParams, ShadingPass, Visibility};
+use gpu::{Background, GBufferPass, Gpu, SceneGeometry, ShadeLight, ShadeParams, ShadingPass, VisibilityLayers};
 use ref_tracer::{EnvLight, Integrator, LightSet, RenderSettings, SceneBvh, render};
 use scene::{Camera, DistantLight, Ggx, Material, Mesh, Object, PointLight, Scene};
 
@@ -19,7 +19,7 @@ fn camera(eye: Vec3, target: Vec3, w: u32, h: u32) -> Camera {
 fn gpu_render(gpu: &Gpu, scene: &Scene, params: &ShadeParams) -> (Vec<Vec3>, Vec<[f32; 4]>) {
     let geometry = SceneGeometry::upload(gpu, scene).unwrap();
     let gb = GBufferPass::new(gpu).render(gpu, &geometry, &scene.camera).unwrap();
-    let vis = Visibility::new(gpu, scene.camera.width, scene.camera.height, params.lights.len() as u32).unwrap();
+    let vis = VisibilityLayers::new(gpu, scene.camera.width, scene.camera.height, params.lights.len() as u32).unwrap();
     let image = ShadingPass::new(gpu).unwrap().render(gpu, &geometry, &gb, params, &vis).unwrap();
     (image, gb.read_positions(gpu).unwrap())
 }
@@ -142,7 +142,7 @@ fn point_light_over_a_lambertian_plane_matches_the_closed_form() {
         camera: camera(Vec3::new(0.0, 4.0, 4.0), Vec3::ZERO, 96, 64),
         point_lights: vec![],
     };
-    let light = PointLight { position: Vec3::new(0.5, 1.5, -0.5), intensity: Vec3::new(4.0, 3.0, 2.0) };
+    let light = PointLight::point(Vec3::new(0.5, 1.5, -0.5), Vec3::new(4.0, 3.0, 2.0));
     let lights = [ShadeLight::from(&light)];
     let (image, positions) = gpu_render(&gpu, &scene, &ShadeParams { lights: &lights, ..Default::default() });
     let mut checked = 0;
@@ -172,7 +172,7 @@ fn adapter_is_described_and_sizes_beyond_the_limits_are_refused() {
     let gpu = gpu();
     assert!(!gpu.describe().is_empty());
     let too_big = gpu.limits.max_texture_dimension_2d + 1;
-    let err = Visibility::new(&gpu, too_big, 4, 1).err().expect("refused");
+    let err = VisibilityLayers::new(&gpu, too_big, 4, 1).err().expect("refused");
     assert!(err.to_string().contains("exceeds the adapter's limit"), "{err}");
 }
 

@@ -18,7 +18,7 @@
 //! let points = gbuffer.read_points(&gpu).expect("reads");
 //! let wedges = penumbra_wedge::Wedges::new(&gpu, &scene, penumbra_wedge::WedgeSettings::default());
 //! let light = LightShape::Distant { direction: glam::Vec3::new(0.3, 1.0, 0.2).normalize(), half_angle: 0.05 };
-//! let vis = gpu::Visibility::new(&gpu, 640, 480, 1).expect("fits");
+//! let vis = gpu::VisibilityLayers::new(&gpu, 640, 480, 1).expect("fits");
 //! let mut encoder = gpu.encoder("frame");
 //! // a renderer records every light of its frame so, then submits once
 //! let report = wedges.record(&gpu, &mut encoder, &Receivers::new(&gbuffer, &points), &light, None, &vis.layer(0));
@@ -612,7 +612,7 @@ impl Wedges {
         }
         let mesh = self.builder.mesh.as_ref().map_err(|e| GpuError::Failed(format!("wedges: {e}")))?;
         let (w, h) = receivers.gbuffer.size();
-        let vis = gpu::Visibility::new(gpu, w, h, 1)?;
+        let vis = gpu::VisibilityLayers::new(gpu, w, h, 1)?;
         let mut encoder = gpu.encoder("silhouette");
         self.record(gpu, &mut encoder, receivers, light, None, &vis.layer(0))?;
         gpu.submit_and_wait(encoder)?;

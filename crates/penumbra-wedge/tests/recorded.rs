@@ -4,7 +4,9 @@
 //! `Wedges::update_object` shadows bit for bit as wedges built afresh for its new pose.
 
 use glam::Vec3;
-use gpu::{GBufferPass, Gpu, LightShape, Receivers, SceneGeometry, Visibility, record_visibility, render_visibility};
+use gpu::{
+    GBufferPass, Gpu, LightShape, Receivers, SceneGeometry, VisibilityLayers, record_visibility, render_visibility,
+};
 use penumbra_wedge::{WedgePath, WedgeSettings, Wedges};
 use scene::Scene;
 
@@ -47,7 +49,7 @@ fn recorded(
     lights: &[LightShape],
 ) -> (Vec<Vec<f32>>, gpu::GpuCounters) {
     let (w, h) = receivers.gbuffer.size();
-    let vis = Visibility::allocate(gpu, w, h, lights.len() as u32).unwrap();
+    let vis = VisibilityLayers::allocate(gpu, w, h, lights.len() as u32).unwrap();
     let mut encoder = gpu.encoder("all lights");
     let before = gpu.counters();
     vis.record_clear(&mut encoder);
@@ -60,7 +62,7 @@ fn recorded(
 
 fn waited(gpu: &Gpu, wedges: &Wedges, receivers: &Receivers, lights: &[LightShape]) -> Vec<Vec<f32>> {
     let (w, h) = receivers.gbuffer.size();
-    let vis = Visibility::new(gpu, w, h, lights.len() as u32).unwrap();
+    let vis = VisibilityLayers::new(gpu, w, h, lights.len() as u32).unwrap();
     render_visibility(gpu, wedges, receivers, lights, &[], &vis).unwrap();
     (0..lights.len() as u32).map(|k| vis.read(gpu, k).unwrap()).collect()
 }
@@ -139,13 +141,13 @@ fn wedges_gated_on_the_gpu_and_planned_for_a_looser_box_equal_wedges_planned_for
     for settings in [WedgeSettings::default(), WedgeSettings { path: WedgePath::Compute, ..WedgeSettings::default() }] {
         let wedges = Wedges::new(&gpu, &scene, settings);
         let (w, h) = gb.size();
-        let vis = Visibility::allocate(&gpu, w, h, all.len() as u32).unwrap();
+        let vis = VisibilityLayers::allocate(&gpu, w, h, all.len() as u32).unwrap();
         let mut encoder = gpu.encoder("read stats");
         vis.record_clear(&mut encoder);
         record_visibility(&gpu, &mut encoder, &wedges, &read, &all, &[], &vis).unwrap();
         gpu.submit(encoder);
         let want: Vec<Vec<f32>> = (0..all.len() as u32).map(|k| vis.read(&gpu, k).unwrap()).collect();
-        let vis = Visibility::allocate(&gpu, w, h, all.len() as u32).unwrap();
+        let vis = VisibilityLayers::allocate(&gpu, w, h, all.len() as u32).unwrap();
         let mut encoder = gpu.encoder("gated");
         let before = gpu.counters();
         vis.record_clear(&mut encoder);

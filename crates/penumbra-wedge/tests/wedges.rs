@@ -6,10 +6,10 @@
 //! (lavapipe).
 
 use glam::Vec3;
-use gpu::{GBufferPass, Gpu, LightShape, Receivers, SceneGeometry, ShadowTechnique, Visibility};
+use gpu::{GBufferPass, Gpu, LightShape, Receivers, SceneGeometry, ShadowTechnique, VisibilityLayers};
 use penumbra_wedge::{WedgeBuild, WedgePath, WedgeSettings, Wedges, coverage};
 use ref_tracer::SceneBvh;
-use ref_tracer::visibility::{AreaLight, VisibilityLight, Weighting, area_light_visibility, light_visibility};
+use ref_tracer::visibility::{Weighting, area_light_visibility, light_visibility};
 use scene::Scene;
 
 fn scene(name: &str, w: u32, h: u32) -> Scene {
@@ -45,7 +45,7 @@ fn light_layer(
     technique: &Wedges,
     receivers: &Receivers,
     light: &LightShape,
-    vis: &Visibility,
+    vis: &VisibilityLayers,
 ) -> gpu::ShadowPassReport {
     let mut encoder = gpu.encoder("light");
     let mut report = [technique.record(gpu, &mut encoder, receivers, light, None, &vis.layer(0)).unwrap()];
@@ -66,17 +66,10 @@ fn render_with(scene: Scene, light: LightShape, settings: WedgeSettings) -> Fram
     let points = gb.read_points(&gpu).unwrap();
     let technique = Wedges::new(&gpu, &scene, settings);
     let (w, h) = gb.size();
-    let vis = Visibility::new(&gpu, w, h, 1).unwrap();
+    let vis = VisibilityLayers::new(&gpu, w, h, 1).unwrap();
     let report = light_layer(&gpu, &technique, &Receivers::new(&gb, &points), &light, &vis);
     let wedges = vis.read(&gpu, 0).unwrap();
     Frame { gpu, scene, points, wedges, report }
-}
-
-fn area(light: &LightShape) -> AreaLight {
-    match *light {
-        LightShape::Distant { direction, half_angle } => AreaLight::Cone { direction, half_angle },
-        LightShape::Sphere { center, radius } => AreaLight::Sphere { center, radius },
-    }
 }
 
 impl Frame {
@@ -86,7 +79,7 @@ impl Frame {
     }
 
     fn truth_weighted(&self, light: &LightShape, weighting: Weighting) -> Vec<Option<f32>> {
-        area_light_visibility(&SceneBvh::new(&self.scene), &self.points, area(light), 32, weighting)
+        area_light_visibility(&SceneBvh::new(&self.scene), &self.points, *light, 32, weighting)
     }
 
     /// The CPU mirror: the same silhouette, the hard count from a ray to the light's centre per
@@ -94,14 +87,10 @@ impl Frame {
     fn mirror(&self, light: &LightShape) -> Vec<Option<f32>> {
         let casters = penumbra_wedge::casters::Casters::new(&self.scene);
         let sil = casters.silhouette(light, |_| true);
-        let centre = match *light {
-            LightShape::Distant { direction, .. } => VisibilityLight::Distant(direction),
-            LightShape::Sphere { center, .. } => VisibilityLight::Point(center),
-        };
         let mut counts: Vec<Option<u32>> = vec![Some(0); self.points.len()];
         for object in &self.scene.objects {
             let alone = Scene { objects: vec![object.clone()], ..self.scene.clone() };
-            let lit = light_visibility(&SceneBvh::new(&alone), &self.points, centre);
+            let lit = light_visibility(&SceneBvh::new(&alone), &self.points, *light);
             for (c, l) in counts.iter_mut().zip(lit) {
                 *c = match (*c, l) {
                     (Some(c), Some(l)) => Some(c + u32::from(!l)),
@@ -175,8 +164,7 @@ fn wedges_approach_ray_traced_visibility() {
 fn tiny_light_gives_the_hard_shadow() {
     let light = sun(0.01);
     let f = render(scene("three_boxes", 160, 120), light);
-    let LightShape::Distant { direction, .. } = light else { unreachable!() };
-    let hard = light_visibility(&SceneBvh::new(&f.scene), &f.points, VisibilityLight::Distant(direction));
+    let hard = light_visibility(&SceneBvh::new(&f.scene), &f.points, light);
     let hard: Vec<Option<f32>> = hard.into_iter().map(|h| h.map(|lit| f32::from(u8::from(lit)))).collect();
     let (_, _, bad, _) = compare(&f.wedges, &hard, 0.5);
     assert!(bad < 0.003, "{:.3} % of pixels disagree", bad * 100.0);
@@ -422,7 +410,7 @@ fn render_view(scene: Scene, view: &gpu::View, light: LightShape) -> Frame {
     let points = gb.read_points(&gpu).unwrap();
     let technique = Wedges::new(&gpu, &scene, WedgeSettings::default());
     let (w, h) = gb.size();
-    let vis = Visibility::new(&gpu, w, h, 1).unwrap();
+    let vis = VisibilityLayers::new(&gpu, w, h, 1).unwrap();
     let report = light_layer(&gpu, &technique, &Receivers::new(&gb, &points), &light, &vis);
     let wedges = vis.read(&gpu, 0).unwrap();
     Frame { gpu, scene, points, wedges, report }
@@ -507,7 +495,7 @@ fn a_gbuffer_made_from_depth_shadows_as_the_rasterized_one() {
     let light = sun(4.0);
     let layer = |gb: &gpu::GBuffer| {
         let points = gb.read_points(&gpu).unwrap();
-        let vis = Visibility::new(&gpu, 160, 120, 1).unwrap();
+        let vis = VisibilityLayers::new(&gpu, 160, 120, 1).unwrap();
         light_layer(&gpu, &technique, &Receivers::new(gb, &points), &light, &vis);
         vis.read(&gpu, 0).unwrap()
     };

@@ -4,21 +4,14 @@
 use crate::bvh::SceneBvh;
 use glam::Vec3;
 use rayon::prelude::*;
+use scene::LightShape;
 
-/// The light whose visibility is traced.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum VisibilityLight {
-    /// A point light at this position.
-    Point(Vec3),
-    /// A distant light in this direction (towards the light).
-    Distant(Vec3),
-}
-
-/// For each `(position, geometric normal)`, whether the light reaches it: `None` for points to
-/// skip (`position` not finite), else a shadow ray from the point offset by the BVH's epsilon
-/// along the normal turned towards the light.
+/// For each `(position, geometric normal)`, whether the centre of `light` reaches it (its hard
+/// shadow; [`area_light_visibility`] traces its whole extent): `None` for points to skip
+/// (`position` not finite), else a shadow ray from the point offset by the BVH's epsilon along
+/// the normal turned towards the light.
 #[must_use]
-pub fn light_visibility(bvh: &SceneBvh, points: &[(Vec3, Vec3)], light: VisibilityLight) -> Vec<Option<bool>> {
+pub fn light_visibility(bvh: &SceneBvh, points: &[(Vec3, Vec3)], light: LightShape) -> Vec<Option<bool>> {
     let eps = bvh.epsilon();
     points
         .par_iter()
@@ -27,12 +20,12 @@ pub fn light_visibility(bvh: &SceneBvh, points: &[(Vec3, Vec3)], light: Visibili
                 return None;
             }
             let (dir, t_max) = match light {
-                VisibilityLight::Point(l) => {
-                    let d = l - p;
+                LightShape::Sphere { center, .. } => {
+                    let d = center - p;
                     let len = d.length();
                     (d / len.max(1e-30), len)
                 }
-                VisibilityLight::Distant(d) => (d.normalize_or(Vec3::Y), f32::INFINITY),
+                LightShape::Distant { direction, .. } => (direction.normalize_or(Vec3::Y), f32::INFINITY),
             };
             let n = if ng.dot(dir) < 0.0 { -ng } else { ng };
             let origin = p + n * eps;
@@ -40,25 +33,6 @@ pub fn light_visibility(bvh: &SceneBvh, points: &[(Vec3, Vec3)], light: Visibili
             Some(!bvh.occluded(origin, dir, t_max))
         })
         .collect()
-}
-
-/// An area light whose visible fraction is traced.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum AreaLight {
-    /// A distant cone light: unit direction towards it and its half-angle (radians).
-    Cone {
-        /// Unit direction towards the light.
-        direction: Vec3,
-        /// Half-angle, radians.
-        half_angle: f32,
-    },
-    /// A local spherical light.
-    Sphere {
-        /// Centre.
-        center: Vec3,
-        /// Radius.
-        radius: f32,
-    },
 }
 
 /// How [`area_light_visibility`] weighs the light's directions.
@@ -84,7 +58,7 @@ pub enum Weighting {
 pub fn area_light_visibility(
     bvh: &SceneBvh,
     points: &[(Vec3, Vec3)],
-    light: AreaLight,
+    light: LightShape,
     n: u32,
     weighting: Weighting,
 ) -> Vec<Option<f32>> {
@@ -97,10 +71,10 @@ pub fn area_light_visibility(
                 return None;
             }
             let (axis, cos_max, center_radius) = match light {
-                AreaLight::Cone { direction, half_angle } => {
+                LightShape::Distant { direction, half_angle } => {
                     (direction.normalize_or(Vec3::Y), half_angle.clamp(0.0, std::f32::consts::PI).cos(), None)
                 }
-                AreaLight::Sphere { center, radius } => {
+                LightShape::Sphere { center, radius } => {
                     let d = center.distance(p);
                     if d <= radius {
                         return Some(1.0);
@@ -149,7 +123,7 @@ pub fn area_light_visibility(
 pub fn area_light_visibility_refined(
     bvh: &SceneBvh,
     points: &[(Vec3, Vec3)],
-    light: AreaLight,
+    light: LightShape,
     width: usize,
     (coarse, fine): (u32, u32),
     weighting: Weighting,
@@ -175,4 +149,21 @@ pub fn area_light_visibility_refined(
         out[k] = v;
     }
     out
+}
+
+/// Fraction of the points with a `truth` value (from [`light_visibility`]) where the
+/// thresholded visibility `mask` (`mask > 0.5` = lit) disagrees with it, and the number of
+/// points compared.
+#[must_use]
+pub fn disagreement(mask: &[f32], truth: &[Option<bool>]) -> (f64, usize) {
+    let (mut wrong, mut n) = (0usize, 0usize);
+    for (m, t) in mask.iter().zip(truth) {
+        if let Some(t) = t {
+            n += 1;
+            if (*m > 0.5) != *t {
+                wrong += 1;
+            }
+        }
+    }
+    (if n == 0 { 0.0 } else { wrong as f64 / n as f64 }, n)
 }

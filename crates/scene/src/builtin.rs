@@ -188,6 +188,6 @@ fn room() -> Scene {
             object("pillar", Mesh::cylinder(Vec3::new(2.0, 0.0, -2.5), 0.3, 3.2, 32), Material::lambert(0.8)),
         ],
         camera: camera(Vec3::new(3.6, 3.2, 3.6), Vec3::new(-0.5, 1.0, -0.5), 70.0),
-        point_lights: vec![PointLight { position: Vec3::new(0.0, 2.0, 0.0), intensity: Vec3::splat(10.0) }],
+        point_lights: vec![PointLight::point(Vec3::new(0.0, 2.0, 0.0), Vec3::splat(10.0))],
     }
 }

@@ -20,12 +20,10 @@ mod visibility;
 
 pub use builtin::BUILTIN_SCENES;
 pub use camera::{Camera, CameraRays};
-pub use light::{DistantLight, cone_cosine_integral};
+pub use light::{DistantLight, LightShape, PointLight, cone_cosine_integral};
 pub use material::{Ggx, Material};
 pub use mesh::{Mesh, normal_matrix};
 pub use visibility::Visibility;
-
-use glam::Vec3;
 
 /// One object: a mesh and its material.
 #[derive(Clone, Debug, PartialEq)]
@@ -36,15 +34,6 @@ pub struct Object {
     pub mesh: Mesh,
     /// Surface material.
     pub material: Material,
-}
-
-/// A point light (used by the `room` scene).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PointLight {
-    /// Position in metres.
-    pub position: Vec3,
-    /// Radiant intensity, W/sr per channel.
-    pub intensity: Vec3,
 }
 
 /// A scene: objects, a camera, and optional point lights. Environment lighting comes from the map.

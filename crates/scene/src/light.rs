@@ -1,5 +1,8 @@
-//! Distant lights: what a light *is*, shared by the extractor that finds them, the reference
-//! tracer and the GPU renderers that draw them.
+//! What a light *is*, shared by the extractor that finds them, the reference tracer and the GPU
+//! renderers that draw them: a distant cone ([`DistantLight`]) or a point or sphere
+//! ([`PointLight`]), each with its power and colour, and the geometry both share
+//! ([`LightShape`]: where a light is and how large, which is all a shadow needs). How a light is
+//! drawn (a shading uniform, a shadow map's view) is derived from these where it is drawn.
 
 use glam::Vec3;
 use std::f32::consts::TAU;
@@ -59,6 +62,104 @@ impl DistantLight {
     #[must_use]
     pub fn contains(&self, dir: Vec3) -> bool {
         dir.dot(self.direction) >= self.cos_half_angle()
+    }
+}
+
+/// A local light: a point (radius 0) or a uniformly emitting sphere around `position`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointLight {
+    /// Position (the sphere's centre), metres.
+    pub position: Vec3,
+    /// Radiant intensity, W/sr per channel. A uniform sphere gives a surface outside it, whose
+    /// horizon it does not cross, the irradiance of a point of this intensity at its centre.
+    pub intensity: Vec3,
+    /// Radius of the emitting sphere, metres; 0 is a point light (hard shadows).
+    pub radius: f32,
+}
+
+impl PointLight {
+    /// A point light (radius 0).
+    #[must_use]
+    pub fn point(position: Vec3, intensity: Vec3) -> Self {
+        Self { position, intensity, radius: 0.0 }
+    }
+}
+
+/// A light's geometry, without its colour: where it is and how large. Shadows need only this;
+/// every shadow technique and the traced truths take it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightShape {
+    /// A distant cone light (the extracted lights): the disk is the cone's cross-section.
+    Distant {
+        /// Unit direction towards the light (the cone's axis).
+        direction: Vec3,
+        /// Half-angle of the cone, radians; 0 is a directional light.
+        half_angle: f32,
+    },
+    /// A local spherical light; radius 0 is a point light.
+    Sphere {
+        /// Centre, metres.
+        center: Vec3,
+        /// Radius, metres.
+        radius: f32,
+    },
+}
+
+impl LightShape {
+    /// The largest half-angle shadow techniques accept: wider cones are clamped to it (a cone
+    /// of 90 degrees or more has no disk cross-section).
+    pub const MAX_HALF_ANGLE: f32 = 1.5;
+
+    /// A point light at `center` (a sphere of radius 0).
+    #[must_use]
+    pub fn point(center: Vec3) -> Self {
+        LightShape::Sphere { center, radius: 0.0 }
+    }
+
+    /// A directional light towards `direction` (a cone of half-angle 0).
+    #[must_use]
+    pub fn directional(direction: Vec3) -> Self {
+        LightShape::Distant { direction, half_angle: 0.0 }
+    }
+
+    /// Half-angle the light subtends from `p` (0 for a point light; pi/2 inside a sphere light).
+    #[must_use]
+    pub fn half_angle_at(&self, p: Vec3) -> f32 {
+        match *self {
+            LightShape::Distant { half_angle, .. } => half_angle.clamp(0.0, Self::MAX_HALF_ANGLE),
+            LightShape::Sphere { center, radius } => {
+                let d = center.distance(p);
+                if d <= radius { std::f32::consts::FRAC_PI_2 } else { (radius / d).asin() }
+            }
+        }
+    }
+
+    /// Unit direction from `p` to the light's centre.
+    #[must_use]
+    pub fn direction_from(&self, p: Vec3) -> Vec3 {
+        match *self {
+            LightShape::Distant { direction, .. } => direction.normalize_or(Vec3::Y),
+            LightShape::Sphere { center, .. } => (center - p).normalize_or(Vec3::Y),
+        }
+    }
+
+    /// Whether any part of the light is above the plane of a surface at `p` with normal `n`.
+    #[must_use]
+    pub fn reaches(&self, p: Vec3, n: Vec3) -> bool {
+        let d = self.direction_from(p);
+        n.dot(d) > -self.half_angle_at(p).sin()
+    }
+}
+
+impl From<&DistantLight> for LightShape {
+    fn from(l: &DistantLight) -> Self {
+        LightShape::Distant { direction: l.direction.normalize_or(Vec3::Y), half_angle: l.half_angle() }
+    }
+}
+
+impl From<&PointLight> for LightShape {
+    fn from(l: &PointLight) -> Self {
+        LightShape::Sphere { center: l.position, radius: l.radius.max(0.0) }
     }
 }
 

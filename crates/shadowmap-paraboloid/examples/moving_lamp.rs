@@ -12,7 +12,7 @@
 
 use glam::{Mat4, Vec3};
 use gpu::ShadowTechnique;
-use gpu::{Gpu, LightShape, ReceiverReduction, Receivers, ShadeLight, Visibility, WEBER_FRACTION, WeberInput};
+use gpu::{Gpu, LightShape, ReceiverReduction, Receivers, ShadeLight, VisibilityLayers, WEBER_FRACTION, WeberInput};
 use shadowmap_paraboloid::{MapTechnique, ShadowSettings, Technique};
 use std::error::Error;
 use std::path::{Path, PathBuf};
@@ -284,7 +284,7 @@ pub fn run(map: Option<&Path>, out: &Path, frames: usize, (w, h): (u32, u32)) ->
     let geometric = target("geometric normal", gformat)?;
     let depth = target("depth", wgpu::TextureFormat::Depth32Float)?;
     let hdr = target("image", gpu::HDR_FORMAT)?;
-    let visibility = Visibility::allocate(&gpu, w, h, shapes.len() as u32)?;
+    let visibility = VisibilityLayers::allocate(&gpu, w, h, shapes.len() as u32)?;
     // the renderer's own matrices (right-handed, reversed infinite depth); the toolkit takes
     // them as they are, jittered or orthographic ones too
     let world_to_view = glam::camera::rh::view::look_at_mat4(camera.eye, camera.target, Vec3::Y);

@@ -1,7 +1,8 @@
 // One shadow view: a paraboloid map (world -> light rigid transform) or a matrix map (cube face,
-// orthographic: world -> clip). The paraboloid arithmetic mirrors
-// `shadowmap_paraboloid::paraboloid` (tests compare the two).
-
+// orthographic: world -> clip). The paraboloid arithmetic is `envmap_sphere::paraboloid`'s front
+// mapping in the view's frame, as `shadowmap_paraboloid::paraboloid` places it (tests compare the
+// two). In the band a map covers (z >= -RIM_MARGIN) the formulas agree; beyond it, where nothing
+// is drawn, this clamp only keeps the result finite.
 const MIN_DENOMINATOR: f32 = 1e-4;
 // Each map covers z >= -RIM_MARGIN, its (u, v) scaled by 1 / UV_SCALE = (1 - m) / sqrt(1 - m^2)
 // to fit: clipping exactly at the rim would leave the clipped triangles' chords inside it.

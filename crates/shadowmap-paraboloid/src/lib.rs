@@ -10,12 +10,12 @@
 //! from the light (rasterization interpolates linearly, the paraboloid mapping is not linear).
 //!
 //! ```no_run
-//! use shadowmap_paraboloid::{ShadowLight, ShadowMapper, ShadowSettings, Technique};
+//! use shadowmap_paraboloid::{MapView, ShadowMapper, ShadowSettings, Technique};
 //! let gpu = gpu::Gpu::new().expect("a GPU or lavapipe");
 //! let scene = scene::Scene::builtin("room").expect("built in");
 //! let geometry = gpu::ShadowGeometry::upload(&gpu, &gpu::scene_triangles(&scene), 64).expect("fits");
 //! let mapper = ShadowMapper::new(&gpu);
-//! let light = ShadowLight::omni(scene.point_lights[0].position);
+//! let light = MapView::omni(scene.point_lights[0].position);
 //! let map = mapper.render(&gpu, &geometry, &light, Technique::DualParaboloid, &ShadowSettings::default());
 //! assert_eq!(map.expect("rendered").views.len(), 2);
 //! ```
@@ -51,9 +51,11 @@ pub enum Rejection {
     Discard,
 }
 
-/// A light as shadow techniques see it.
+/// Where one shadow map looks from: a point (with the hemisphere it must cover) or a direction.
+/// It is how a light is *drawn* here, not what it is: [`MapTechnique`] derives one view from a
+/// point or sphere [`scene::LightShape`] and several from a wide cone (one per sample direction).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum ShadowLight {
+pub enum MapView {
     /// A point light; `hemisphere` is the axis of its emitting hemisphere, or `None` when it
     /// emits in all directions.
     Point {
@@ -69,7 +71,7 @@ pub enum ShadowLight {
     },
 }
 
-impl ShadowLight {
+impl MapView {
     /// An omnidirectional point light.
     #[must_use]
     pub fn omni(position: Vec3) -> Self {
@@ -161,79 +163,14 @@ impl ShadowSettings {
 #[must_use]
 pub fn shadow_triangles<'a>(
     triangles: &'a [[Vec3; 3]],
-    light: &ShadowLight,
+    light: &MapView,
     technique: Technique,
     settings: &ShadowSettings,
 ) -> std::borrow::Cow<'a, [[Vec3; 3]]> {
     match (technique, light, settings.subdivide_angle) {
-        (Technique::DualParaboloid, ShadowLight::Point { position, .. }, Some(angle)) => {
+        (Technique::DualParaboloid, MapView::Point { position, .. }, Some(angle)) => {
             std::borrow::Cow::Owned(subdivide::subdivide_for_light(triangles, *position, angle))
         }
         _ => std::borrow::Cow::Borrowed(triangles),
     }
-}
-
-/// Fraction of the pixels with a `truth` value where the thresholded visibility mask
-/// (`mask > 0.5` = lit) disagrees with it, and the number of pixels compared.
-#[must_use]
-pub fn disagreement(mask: &[f32], truth: &[Option<bool>]) -> (f64, usize) {
-    let (mut wrong, mut n) = (0usize, 0usize);
-    for (m, t) in mask.iter().zip(truth) {
-        if let Some(t) = t {
-            n += 1;
-            if (*m > 0.5) != *t {
-                wrong += 1;
-            }
-        }
-    }
-    (if n == 0 { 0.0 } else { wrong as f64 / n as f64 }, n)
-}
-
-/// Map sides with (nearly) equal texel counts: a dual paraboloid map of side `p` (2 p² texels)
-/// against a cube map of side `c` (6 c² texels), c = p / √3 rounded to a multiple of 8. The
-/// accuracy and speed comparisons use these pairs.
-pub const EQUAL_TEXEL_SIDES: [(u32, u32); 3] = [(512, 296), (1024, 592), (2048, 1184)];
-
-/// A named shadow-map configuration.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Variant {
-    /// Name, e.g. `paraboloid_1024_clip_subdivided`.
-    pub name: String,
-    /// The technique.
-    pub technique: Technique,
-    /// Its settings.
-    pub settings: ShadowSettings,
-}
-
-/// The paraboloid-against-cube comparison of the validate report and the bench: for each pair of
-/// [`EQUAL_TEXEL_SIDES`], the cube map and the dual paraboloid map with clip distances (plain and
-/// subdivided) and with a discard (subdivided).
-#[must_use]
-pub fn equal_texel_variants() -> Vec<Variant> {
-    let mut out = Vec::new();
-    for (p, c) in EQUAL_TEXEL_SIDES {
-        let base = ShadowSettings::default();
-        let variant = |name: String, technique, resolution, rejection, subdivide_angle| Variant {
-            name,
-            technique,
-            settings: ShadowSettings { resolution, rejection, subdivide_angle, ..base },
-        };
-        out.push(variant(format!("cube_{c}"), Technique::Cube, c, Rejection::ClipDistance, None));
-        out.push(variant(format!("paraboloid_{p}_clip"), Technique::DualParaboloid, p, Rejection::ClipDistance, None));
-        out.push(variant(
-            format!("paraboloid_{p}_clip_subdivided"),
-            Technique::DualParaboloid,
-            p,
-            Rejection::ClipDistance,
-            base.subdivide_angle,
-        ));
-        out.push(variant(
-            format!("paraboloid_{p}_discard_subdivided"),
-            Technique::DualParaboloid,
-            p,
-            Rejection::Discard,
-            base.subdivide_angle,
-        ));
-    }
-    out
 }

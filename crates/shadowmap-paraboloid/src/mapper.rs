@@ -2,7 +2,7 @@
 //! culling), and the visibility pass that turns a map into a screen-space visibility layer.
 
 use crate::paraboloid::{Hemisphere, ParaboloidFrame};
-use crate::{Rejection, ShadowLight, ShadowSettings, Technique};
+use crate::{MapView, Rejection, ShadowSettings, Technique};
 use glam::{Mat4, Vec3};
 use gpu::{Calls, Chunk, Clock, GBuffer, Gate, Gpu, GpuError, GpuStats, Indirect, ShadowGeometry};
 use std::time::Duration;
@@ -59,7 +59,7 @@ pub struct ShadowMap {
     /// The technique.
     pub technique: Technique,
     /// The light.
-    pub light: ShadowLight,
+    pub light: MapView,
     /// The paraboloid frame, for paraboloid maps.
     pub frame: Option<ParaboloidFrame>,
     /// The settings it was made with (rejection as actually used).
@@ -122,8 +122,8 @@ impl ShadowMap {
     #[must_use]
     pub fn lookup_params(&self, half_angle: f32, first_layer: u32) -> MapParams {
         let (light, kind) = match self.light {
-            ShadowLight::Point { position, .. } => (position, 0.0),
-            ShadowLight::Distant { direction } => (direction.normalize_or(Vec3::Y), 1.0),
+            MapView::Point { position, .. } => (position, 0.0),
+            MapView::Distant { direction } => (direction.normalize_or(Vec3::Y), 1.0),
         };
         let technique = match self.technique {
             Technique::DualParaboloid => 0.0,
@@ -394,7 +394,7 @@ impl ShadowMapper {
             _ => include_str!("../shaders/visibility.wgsl"),
         };
         let module = gpu::shader::module(&gpu.device, "shadow visibility", src("visibility"), LIBRARY);
-        let visibility = gpu::fullscreen::pipeline(gpu, "shadow visibility", &module, gpu::Visibility::FORMAT);
+        let visibility = gpu::fullscreen::pipeline(gpu, "shadow visibility", &module, gpu::VisibilityLayers::FORMAT);
         let visibility_add = gpu::fullscreen::pipeline_with_target(
             gpu,
             "shadow visibility (add)",
@@ -457,7 +457,7 @@ impl ShadowMapper {
         &self,
         gpu: &Gpu,
         geometry: &ShadowGeometry,
-        light: &ShadowLight,
+        light: &MapView,
         technique: Technique,
         settings: &ShadowSettings,
     ) -> Result<ShadowMap, GpuError> {
@@ -490,7 +490,7 @@ impl ShadowMapper {
         gpu: &Gpu,
         encoder: &mut wgpu::CommandEncoder,
         geometry: &ShadowGeometry,
-        light: &ShadowLight,
+        light: &MapView,
         technique: Technique,
         settings: &ShadowSettings,
         target: Option<(&wgpu::Texture, u32)>,
@@ -511,13 +511,13 @@ impl ShadowMapper {
         encoder: &mut wgpu::CommandEncoder,
         geometry: &ShadowGeometry,
         mut p: Prepared<'_>,
-        (light, settings, stats): (&ShadowLight, &ShadowSettings, Option<&GpuStats>),
+        (light, settings, stats): (&MapView, &ShadowSettings, Option<&GpuStats>),
         (depth, calls, first): (DepthCalls, &Calls, usize),
     ) -> ShadowMap {
         // moved objects' vertices first (nothing when none moved)
         geometry.record_placement(gpu, encoder);
         let fit = match (p.map.technique, light, stats) {
-            (Technique::Orthographic, ShadowLight::Distant { direction }, Some(stats)) if settings.focus.is_none() => {
+            (Technique::Orthographic, MapView::Distant { direction }, Some(stats)) if settings.focus.is_none() => {
                 Some(self.record_focus(gpu, encoder, geometry, *direction, settings.resolution, stats))
             }
             _ => None,
@@ -602,9 +602,9 @@ impl ShadowMapper {
     /// The views (texture layers) a map of `light` by `technique` has: a hemispherical
     /// paraboloid 1, an omnidirectional one 2, a cube 6, an orthographic map 1.
     #[must_use]
-    pub fn view_count(light: &ShadowLight, technique: Technique) -> u32 {
+    pub fn view_count(light: &MapView, technique: Technique) -> u32 {
         match (technique, light) {
-            (Technique::DualParaboloid, ShadowLight::Point { hemisphere: Some(_), .. }) => 1,
+            (Technique::DualParaboloid, MapView::Point { hemisphere: Some(_), .. }) => 1,
             (Technique::DualParaboloid, _) => 2,
             (Technique::Cube, _) => 6,
             (Technique::Orthographic, _) => 1,
@@ -616,7 +616,7 @@ impl ShadowMapper {
         &self,
         gpu: &Gpu,
         geometry: &ShadowGeometry,
-        light: &ShadowLight,
+        light: &MapView,
         technique: Technique,
         settings: &ShadowSettings,
         target: Option<(&wgpu::Texture, u32)>,
@@ -633,7 +633,7 @@ impl ShadowMapper {
         let mut views: Vec<(ShadowView, Classifier)> = Vec::new();
         let cull = settings.cull;
         match (technique, *light) {
-            (Technique::DualParaboloid, ShadowLight::Point { position, hemisphere }) => {
+            (Technique::DualParaboloid, MapView::Point { position, hemisphere }) => {
                 let f = ParaboloidFrame::new(
                     position,
                     hemisphere.unwrap_or(Vec3::NEG_Y),
@@ -662,7 +662,7 @@ impl ShadowMapper {
                     ));
                 }
             }
-            (Technique::Cube, ShadowLight::Point { position, .. }) => {
+            (Technique::Cube, MapView::Point { position, .. }) => {
                 let far = far_from(position);
                 let proj =
                     glam::camera::rh::proj::directx::perspective(std::f32::consts::FRAC_PI_2, 1.0, settings.near, far);
@@ -685,7 +685,7 @@ impl ShadowMapper {
                     ));
                 }
             }
-            (Technique::Orthographic, ShadowLight::Distant { direction }) => {
+            (Technique::Orthographic, MapView::Distant { direction }) => {
                 let (center, radius) = bounds(geometry);
                 let d = direction.normalize_or(Vec3::Y);
                 let up = if d.y.abs() < 0.9 { Vec3::Y } else { Vec3::X };

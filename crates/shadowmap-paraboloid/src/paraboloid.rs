@@ -1,18 +1,21 @@
-//! The paraboloid mapping of Brabec, Annen and Seidel (paper 004), on the CPU: a direction d in
-//! a light's frame (hemisphere z >= 0) maps to the point where the paraboloid
-//! f(x, y) = 1/2 - (x^2 + y^2)/2 reflects d into +z, whose normal is the halfway vector
-//! (d + z) — so (u, v) = (d.x, d.y) / (1 + d.z), the unit disk for the hemisphere. Depth is the
-//! distance to the light between a near and a far sphere, mapped to [0, 1].
+//! The paraboloid mapping of Brabec, Annen and Seidel (paper 004) in a light's frame, on the
+//! CPU: a direction d in the frame of one map (its hemisphere z >= 0) maps to the point where the
+//! paraboloid f(x, y) = 1/2 - (x^2 + y^2)/2 reflects d into +z, whose normal is the halfway
+//! vector (d + z) — so (u, v) = (d.x, d.y) / (1 + d.z), the unit disk for the hemisphere. Depth
+//! is the distance to the light between a near and a far sphere, mapped to [0, 1].
 //!
-//! The back map of a dual paraboloid uses the frame turned 180° about its y axis, (x, y, z) ->
-//! (-x, y, -z). The GPU shaders (`crates/shadowmap-paraboloid/shaders/paraboloid.wgsl`) do the same
-//! arithmetic; tests compare both.
+//! The mapping itself, and the back map's frame (the front's turned 180° about its y axis,
+//! (x, y, z) -> (-x, y, -z)), are `envmap_sphere::paraboloid`'s: the project has one paraboloid
+//! mapping, and this module places it in a light's frame. The GPU shaders
+//! (`crates/shadowmap-paraboloid/shaders/paraboloid.wgsl`) do the same arithmetic; tests compare
+//! both.
 
+use envmap_sphere::paraboloid::{paraboloid_dir_to_point, paraboloid_point_to_dir};
 use glam::{Mat4, Vec2, Vec3};
 
-/// Smallest 1 + z used as the divisor: directions within ~1.4e-2 rad of the singular direction
-/// z = -1 land at radius <= 1e4 instead of infinity (as `envmap_sphere`'s paraboloid clamp).
-pub const MIN_DENOMINATOR: f32 = 1e-4;
+/// Which map of a dual paraboloid: the environment maps' [`envmap_sphere::paraboloid::Hemisphere`]
+/// (front around the light's forward axis, +z of its frame; back around the opposite axis).
+pub use envmap_sphere::paraboloid::Hemisphere;
 
 /// Each map covers its hemisphere plus a band of this height below the rim (z >= -margin):
 /// clipping at exactly z = 0 leaves the polygonal outline of the clipped triangles (chords)
@@ -25,15 +28,6 @@ pub const RIM_MARGIN: f32 = 0.05;
 #[must_use]
 pub fn uv_scale() -> f32 {
     (1.0 - RIM_MARGIN * RIM_MARGIN).sqrt() / (1.0 - RIM_MARGIN)
-}
-
-/// Which map of a dual paraboloid.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Hemisphere {
-    /// Around the light's forward axis (+z of its frame).
-    Front,
-    /// Around the opposite axis.
-    Back,
 }
 
 /// A light's paraboloid frame: position, axes, and the depth range.
@@ -110,8 +104,9 @@ impl ParaboloidFrame {
             let c = ParaboloidCoords { hemisphere, uv: Vec2::ZERO, depth: self.depth(0.0) };
             return (c, 1.0);
         }
+        // `l` is in this map's frame already: the front mapping applies
         let n = l / dist;
-        let uv = Vec2::new(n.x, n.y) / ((1.0 + n.z).max(MIN_DENOMINATOR) * uv_scale());
+        let uv = paraboloid_dir_to_point(n, Hemisphere::Front) / uv_scale();
         (ParaboloidCoords { hemisphere, uv, depth: self.depth(dist) }, n.z + RIM_MARGIN)
     }
 
@@ -124,14 +119,9 @@ impl ParaboloidFrame {
     /// The unit world direction at `uv` of a map (the inverse of the mapping on the disk).
     #[must_use]
     pub fn direction(&self, uv: Vec2, hemisphere: Hemisphere) -> Vec3 {
-        let uv = uv * uv_scale();
-        let r2 = uv.length_squared();
-        let local = Vec3::new(2.0 * uv.x, 2.0 * uv.y, 1.0 - r2) / (1.0 + r2);
-        let (r, u, f) = match hemisphere {
-            Hemisphere::Front => (self.right, self.up(), self.forward),
-            Hemisphere::Back => (-self.right, self.up(), -self.forward),
-        };
-        (r * local.x + u * local.y + f * local.z).normalize()
+        // in the front map's frame (right, up, forward); the back map's turn is the mapping's
+        let local = paraboloid_point_to_dir(uv * uv_scale(), hemisphere);
+        (self.right * local.x + self.up() * local.y + self.forward * local.z).normalize()
     }
 }
 
@@ -170,6 +160,24 @@ mod tests {
     }
 
     #[test]
+    fn maps_directions_as_the_environment_maps_paraboloid_does() {
+        // A frame on the world axes (forward +Z gives right +X, up +Y): each map's (u, v) is
+        // envmap_sphere's paraboloid point of the direction, back map included.
+        let f = ParaboloidFrame::new(Vec3::ZERO, Vec3::Z, 0.01, 10.0);
+        assert!(f.right.abs_diff_eq(Vec3::X, 1e-6) && f.up().abs_diff_eq(Vec3::Y, 1e-6));
+        for k in 0..400 {
+            let a = k as f32 * 2.399_963;
+            let z = 1.0 - 2.0 * (k as f32 + 0.5) / 400.0;
+            let s = (1.0 - z * z).sqrt();
+            let d = Vec3::new(s * a.cos(), s * a.sin(), z);
+            let c = f.project(d * 2.0);
+            assert_eq!(c.hemisphere, Hemisphere::of(d));
+            let want = paraboloid_dir_to_point(d, c.hemisphere);
+            assert!((c.uv * uv_scale() - want).length() < 1e-5, "{d}: {:?} vs {want}", c.uv * uv_scale());
+        }
+    }
+
+    #[test]
     fn rim_lands_on_the_unit_circle_of_either_map() {
         let f = frame();
         for k in 0..64 {
@@ -200,7 +208,7 @@ mod tests {
         ] {
             let (c, z) = f.project_into(p, h);
             assert!(c.uv.is_finite() && c.depth.is_finite() && z.is_finite(), "{p}: {c:?} {z}");
-            assert!(c.uv.length() <= 1.0 / MIN_DENOMINATOR);
+            assert!(c.uv.length() <= envmap_sphere::paraboloid::PARABOLOID_MAX_RADIUS);
         }
     }
 }

@@ -3,7 +3,7 @@
 //! Herf 1997, paper 000's reference method).
 
 use crate::mapper::{DepthCalls, ShadowMapper, VisibilityTarget};
-use crate::{ShadowLight, ShadowSettings, Technique, shadow_triangles};
+use crate::{MapView, ShadowSettings, Technique, shadow_triangles};
 use glam::Vec3;
 use gpu::accumulate::{Accumulator, ResolvePass};
 use gpu::{Gpu, GpuError, LightShape, Receivers, ShadowGeometry, ShadowPassReport, ShadowTechnique};
@@ -43,7 +43,7 @@ struct Scratch {
 /// solid angle: a Vogel spiral through the cone's own sampling (`DistantLight::sample_direction`);
 /// the centre alone for n = 1.
 #[must_use]
-pub fn cone_directions(axis: Vec3, half_angle: f32, n: u32) -> Vec<Vec3> {
+pub fn cone_sample_directions(axis: Vec3, half_angle: f32, n: u32) -> Vec<Vec3> {
     let axis = axis.normalize_or(Vec3::Y);
     if n <= 1 {
         return vec![axis];
@@ -199,15 +199,15 @@ impl ShadowTechnique for MapTechnique {
             return Err(GpuError::Failed(format!("{} cannot shadow {light:?}", self.name())));
         }
         let settings = ShadowSettings { focus: self.settings.focus.or(receivers.focus), ..self.settings };
-        let (lights, half_angle): (Vec<ShadowLight>, f32) = match *light {
+        let (lights, half_angle): (Vec<MapView>, f32) = match *light {
             LightShape::Distant { direction, half_angle } => (
-                cone_directions(direction, half_angle, self.samples)
+                cone_sample_directions(direction, half_angle, self.samples)
                     .into_iter()
-                    .map(|direction| ShadowLight::Distant { direction })
+                    .map(|direction| MapView::Distant { direction })
                     .collect(),
                 half_angle,
             ),
-            LightShape::Sphere { center, .. } => (vec![ShadowLight::omni(center)], 0.0),
+            LightShape::Sphere { center, .. } => (vec![MapView::omni(center)], 0.0),
         };
         let shared = &self.shared;
         let subdivided;

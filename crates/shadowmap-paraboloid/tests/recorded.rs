@@ -5,7 +5,9 @@
 //! for its new pose.
 
 use glam::Vec3;
-use gpu::{GBufferPass, Gpu, LightShape, Receivers, SceneGeometry, Visibility, record_visibility, render_visibility};
+use gpu::{
+    GBufferPass, Gpu, LightShape, Receivers, SceneGeometry, VisibilityLayers, record_visibility, render_visibility,
+};
 use shadowmap_paraboloid::{MapTechnique, ShadowSettings, Technique};
 
 fn scene() -> scene::Scene {
@@ -46,7 +48,7 @@ fn recorded(
 
 fn waited(gpu: &Gpu, t: &MapTechnique, receivers: &Receivers, lights: &[LightShape]) -> Vec<Vec<f32>> {
     let (w, h) = receivers.gbuffer.size();
-    let vis = Visibility::new(gpu, w, h, lights.len() as u32).unwrap();
+    let vis = VisibilityLayers::new(gpu, w, h, lights.len() as u32).unwrap();
     render_visibility(gpu, t, receivers, lights, &[], &vis).unwrap();
     (0..lights.len() as u32).map(|k| vis.read(gpu, k).unwrap()).collect()
 }
@@ -177,7 +179,7 @@ fn recorded_any(
     lights: &[LightShape],
 ) -> (Vec<Vec<f32>>, gpu::GpuCounters, Vec<gpu::ShadowPassReport>) {
     let (w, h) = receivers.gbuffer.size();
-    let vis = Visibility::allocate(gpu, w, h, lights.len() as u32).unwrap();
+    let vis = VisibilityLayers::allocate(gpu, w, h, lights.len() as u32).unwrap();
     let mut encoder = gpu.encoder("all lights");
     let before = gpu.counters();
     vis.record_clear(&mut encoder);

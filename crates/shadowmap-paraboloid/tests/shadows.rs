@@ -3,14 +3,14 @@
 //! direction, the hemisphere boundary, tiny and huge scales, a light inside an occluder.
 
 use glam::Vec3;
-use gpu::{GBuffer, GBufferPass, Gpu, SceneGeometry, ShadowGeometry, Visibility, scene_triangles};
+use gpu::{GBuffer, GBufferPass, Gpu, SceneGeometry, ShadowGeometry, VisibilityLayers, scene_triangles};
 use ref_tracer::SceneBvh;
-use ref_tracer::visibility::{VisibilityLight, light_visibility};
-use scene::{Material, Mesh, Object, Scene};
+use ref_tracer::visibility::{disagreement, light_visibility};
+use scene::{LightShape, Material, Mesh, Object, Scene};
 use shadowmap_paraboloid::cpu::{CpuParaboloidMap, lit};
 use shadowmap_paraboloid::paraboloid::Hemisphere;
 use shadowmap_paraboloid::{
-    OnGpu, Rejection, ShadowLight, ShadowMap, ShadowMapper, ShadowSettings, Technique, disagreement, shadow_triangles,
+    MapView, OnGpu, Rejection, ShadowMap, ShadowMapper, ShadowSettings, Technique, shadow_triangles,
 };
 
 fn gpu() -> Gpu {
@@ -43,7 +43,7 @@ impl Setup {
         Self { gpu, scene, gb, points, mapper }
     }
 
-    fn map(&self, triangles: &[[Vec3; 3]], light: &ShadowLight, t: Technique, s: &ShadowSettings) -> ShadowMap {
+    fn map(&self, triangles: &[[Vec3; 3]], light: &MapView, t: Technique, s: &ShadowSettings) -> ShadowMap {
         let triangles = shadow_triangles(triangles, light, t, s);
         let geometry = ShadowGeometry::upload(&self.gpu, &triangles, ShadowGeometry::CHUNK_TRIANGLES).unwrap();
         let map = self.mapper.render(&self.gpu, &geometry, light, t, s).unwrap();
@@ -56,12 +56,12 @@ impl Setup {
 
     fn mask(&self, map: &ShadowMap) -> Vec<f32> {
         let (w, h) = self.gb.size();
-        let vis = Visibility::new(&self.gpu, w, h, 1).unwrap();
+        let vis = VisibilityLayers::new(&self.gpu, w, h, 1).unwrap();
         self.mapper.visibility(&self.gpu, map, &self.gb, &vis.layer(0)).unwrap();
         vis.read(&self.gpu, 0).unwrap()
     }
 
-    fn truth(&self, light: VisibilityLight) -> Vec<Option<bool>> {
+    fn truth(&self, light: LightShape) -> Vec<Option<bool>> {
         light_visibility(&SceneBvh::new(&self.scene), &self.points, light)
     }
 }
@@ -77,7 +77,7 @@ fn the_clip_distance_path_runs_where_the_adapter_has_it() {
     }
     let s = Setup::new(room(8, 8));
     let tris = scene_triangles(&s.scene);
-    let light = ShadowLight::omni(s.scene.point_lights[0].position);
+    let light = MapView::omni(s.scene.point_lights[0].position);
     for rejection in [Rejection::ClipDistance, Rejection::Discard] {
         let settings = ShadowSettings { resolution: 64, rejection, ..ShadowSettings::default() };
         // `Setup::map` asserts the rejection that ran
@@ -90,7 +90,7 @@ fn the_clip_distance_path_runs_where_the_adapter_has_it() {
 fn gpu_paraboloid_maps_match_the_cpu_rasterizer() {
     let s = Setup::new(room(8, 8));
     let tris = scene_triangles(&s.scene);
-    let light = ShadowLight::omni(s.scene.point_lights[0].position);
+    let light = MapView::omni(s.scene.point_lights[0].position);
     for rejection in [Rejection::ClipDistance, Rejection::Discard] {
         let settings =
             ShadowSettings { resolution: 256, rejection, subdivide_angle: None, ..ShadowSettings::default() };
@@ -110,7 +110,7 @@ fn gpu_paraboloid_maps_match_the_cpu_rasterizer() {
 fn gpu_visibility_matches_the_cpu_shadow_test() {
     let s = Setup::new(room(160, 120));
     let tris = scene_triangles(&s.scene);
-    let light = ShadowLight::omni(s.scene.point_lights[0].position);
+    let light = MapView::omni(s.scene.point_lights[0].position);
     let settings = ShadowSettings { resolution: 512, subdivide_angle: None, ..ShadowSettings::default() };
     let map = s.map(&tris, &light, Technique::DualParaboloid, &settings);
     let frame = map.frame.unwrap();
@@ -130,11 +130,11 @@ fn paraboloid_and_cube_agree_with_ray_traced_visibility_in_the_room() {
     let s = Setup::new(room(320, 240));
     let tris = scene_triangles(&s.scene);
     let position = s.scene.point_lights[0].position;
-    let truth = s.truth(VisibilityLight::Point(position));
+    let truth = s.truth(LightShape::point(position));
     for (technique, res) in [(Technique::DualParaboloid, 1024), (Technique::Cube, 592)] {
         for rejection in [Rejection::ClipDistance, Rejection::Discard] {
             let settings = ShadowSettings { resolution: res, rejection, ..ShadowSettings::default() };
-            let map = s.map(&tris, &ShadowLight::omni(position), technique, &settings);
+            let map = s.map(&tris, &MapView::omni(position), technique, &settings);
             let (frac, n) = disagreement(&s.mask(&map), &truth);
             assert!(n > 50_000 && frac < 0.002, "{technique:?} {rejection:?}: {:.3} % disagree", frac * 100.0);
         }
@@ -146,12 +146,12 @@ fn a_hemispherical_light_gets_one_map_and_lights_only_its_hemisphere() {
     let s = Setup::new(room(160, 120));
     let tris = scene_triangles(&s.scene);
     let position = s.scene.point_lights[0].position;
-    let light = ShadowLight::Point { position, hemisphere: Some(Vec3::NEG_Y) };
+    let light = MapView::Point { position, hemisphere: Some(Vec3::NEG_Y) };
     let map = s.map(&tris, &light, Technique::DualParaboloid, &ShadowSettings::default());
     assert_eq!(map.views.len(), 1);
     let mask = s.mask(&map);
     let points = &s.points;
-    let truth = s.truth(VisibilityLight::Point(position));
+    let truth = s.truth(LightShape::point(position));
     let (mut above, mut wrong_below) = (0, 0);
     for ((m, (p, _)), t) in mask.iter().zip(points).zip(&truth) {
         if p.is_finite() && p.y > position.y + 0.05 {
@@ -176,8 +176,7 @@ fn the_singular_direction_leaves_the_front_map_clean() {
     for rejection in [Rejection::ClipDistance, Rejection::Discard] {
         let settings = ShadowSettings { resolution: 128, rejection, cull: false, ..ShadowSettings::default() };
         // front axis -Y: the occluder above is at z = -1 of the front map
-        let map =
-            s.map(&tris, &ShadowLight::Point { position, hemisphere: None }, Technique::DualParaboloid, &settings);
+        let map = s.map(&tris, &MapView::Point { position, hemisphere: None }, Technique::DualParaboloid, &settings);
         let front = map.read_layer(&s.gpu, 0).unwrap();
         assert!(front.iter().all(|d| *d == 1.0), "{rejection:?}: front map drew the occluder behind it");
         let back = map.read_layer(&s.gpu, 1).unwrap();
@@ -200,12 +199,12 @@ fn an_occluder_across_the_hemisphere_boundary_shadows_both_sides() {
     let s = Setup::new(scene);
     let tris = scene_triangles(&s.scene);
     let position = s.scene.point_lights[0].position;
-    let truth = s.truth(VisibilityLight::Point(position));
+    let truth = s.truth(LightShape::point(position));
     let plain = ShadowSettings { subdivide_angle: None, ..ShadowSettings::default() };
-    let map = s.map(&tris, &ShadowLight::omni(position), Technique::DualParaboloid, &plain);
+    let map = s.map(&tris, &MapView::omni(position), Technique::DualParaboloid, &plain);
     let (frac, _) = disagreement(&s.mask(&map), &truth);
     // the boundary is where linear interpolation of the non-linear mapping is worst
-    let map = s.map(&tris, &ShadowLight::omni(position), Technique::DualParaboloid, &ShadowSettings::default());
+    let map = s.map(&tris, &MapView::omni(position), Technique::DualParaboloid, &ShadowSettings::default());
     let (frac_sub, _) = disagreement(&s.mask(&map), &truth);
     assert!(frac_sub < 0.002 && frac_sub * 4.0 < frac, "disagreement {frac} plain, {frac_sub} subdivided");
 }
@@ -226,8 +225,8 @@ fn tiny_and_huge_scenes_shadow_alike() {
         let s = Setup::new(scene);
         let position = s.scene.point_lights[0].position;
         let settings = ShadowSettings { near: 0.01 * scale, ..ShadowSettings::default() };
-        let map = s.map(&scene_triangles(&s.scene), &ShadowLight::omni(position), Technique::DualParaboloid, &settings);
-        let (frac, n) = disagreement(&s.mask(&map), &s.truth(VisibilityLight::Point(position)));
+        let map = s.map(&scene_triangles(&s.scene), &MapView::omni(position), Technique::DualParaboloid, &settings);
+        let (frac, n) = disagreement(&s.mask(&map), &s.truth(LightShape::point(position)));
         assert!(n > 10_000);
         fracs.push(frac);
     }
@@ -246,7 +245,7 @@ fn a_light_inside_an_occluder_shadows_everything_outside() {
     let s = Setup::new(scene);
     let tris = scene_triangles(&s.scene);
     for technique in [Technique::DualParaboloid, Technique::Cube] {
-        let map = s.map(&tris, &ShadowLight::omni(position), technique, &ShadowSettings::fast());
+        let map = s.map(&tris, &MapView::omni(position), technique, &ShadowSettings::fast());
         let mask = s.mask(&map);
         let points = &s.points;
         let outside: Vec<f32> = mask
@@ -270,9 +269,8 @@ fn orthographic_map_of_a_distant_light_agrees_with_ray_tracing() {
     let s = Setup::new(scene);
     let tris = scene_triangles(&s.scene);
     let dir = Vec3::new(0.4, 0.8, 0.3).normalize();
-    let map =
-        s.map(&tris, &ShadowLight::Distant { direction: dir }, Technique::Orthographic, &ShadowSettings::quality());
-    let (frac, n) = disagreement(&s.mask(&map), &s.truth(VisibilityLight::Distant(dir)));
+    let map = s.map(&tris, &MapView::Distant { direction: dir }, Technique::Orthographic, &ShadowSettings::quality());
+    let (frac, n) = disagreement(&s.mask(&map), &s.truth(LightShape::directional(dir)));
     assert!(n > 30_000 && frac < 0.01, "{:.3} % disagree", frac * 100.0);
 }
 
@@ -283,13 +281,7 @@ fn mismatched_technique_and_light_is_an_error() {
     let geometry = ShadowGeometry::upload(&s.gpu, &tris, 64).unwrap();
     let err = s
         .mapper
-        .render(
-            &s.gpu,
-            &geometry,
-            &ShadowLight::Distant { direction: Vec3::Y },
-            Technique::Cube,
-            &ShadowSettings::fast(),
-        )
+        .render(&s.gpu, &geometry, &MapView::Distant { direction: Vec3::Y }, Technique::Cube, &ShadowSettings::fast())
         .err()
         .expect("refused");
     assert!(err.to_string().contains("does not fit"), "{err}");
@@ -299,7 +291,7 @@ fn mismatched_technique_and_light_is_an_error() {
 fn pcf_softens_only_the_shadow_edges() {
     let s = Setup::new(room(320, 240));
     let tris = scene_triangles(&s.scene);
-    let light = ShadowLight::omni(s.scene.point_lights[0].position);
+    let light = MapView::omni(s.scene.point_lights[0].position);
     let hard = s.mask(&s.map(&tris, &light, Technique::DualParaboloid, &ShadowSettings::default()));
     let pcf = ShadowSettings { pcf_radius: 2, ..ShadowSettings::default() };
     let soft = s.mask(&s.map(&tris, &light, Technique::DualParaboloid, &pcf));
@@ -321,10 +313,10 @@ fn maps_recorded_into_one_submission_equal_maps_rendered_one_by_one() {
     let settings = ShadowSettings { resolution: 64, subdivide_angle: None, ..ShadowSettings::default() };
     let p = s.scene.point_lights[0].position;
     let lights = [
-        (ShadowLight::omni(p), Technique::DualParaboloid),
-        (ShadowLight::Point { position: p + Vec3::X, hemisphere: Some(Vec3::NEG_Y) }, Technique::DualParaboloid),
-        (ShadowLight::omni(p - Vec3::X), Technique::Cube),
-        (ShadowLight::Distant { direction: Vec3::new(0.3, 1.0, 0.2) }, Technique::Orthographic),
+        (MapView::omni(p), Technique::DualParaboloid),
+        (MapView::Point { position: p + Vec3::X, hemisphere: Some(Vec3::NEG_Y) }, Technique::DualParaboloid),
+        (MapView::omni(p - Vec3::X), Technique::Cube),
+        (MapView::Distant { direction: Vec3::new(0.3, 1.0, 0.2) }, Technique::Orthographic),
     ];
     // the first two into one shared array (its layers 1.. : layer 0 stays unused), the others
     // into textures of their own

@@ -3,9 +3,9 @@
 //! paper 000's scenes at 160 x 120 (lavapipe where there is no GPU).
 
 use glam::Vec3;
-use gpu::{GBufferPass, Gpu, LightShape, Receivers, SceneGeometry, Visibility};
+use gpu::{GBufferPass, Gpu, LightShape, Receivers, SceneGeometry, VisibilityLayers};
 use ref_tracer::SceneBvh;
-use ref_tracer::visibility::{AreaLight, Weighting, area_light_visibility};
+use ref_tracer::visibility::{Weighting, area_light_visibility};
 use shadowmap_paraboloid::{MapTechnique, Pcss, ShadowSettings, Technique};
 
 /// (mean |error| over pixels the light reaches, mean over penumbra pixels, penumbra pixels).
@@ -20,16 +20,10 @@ fn errors(name: &str, degrees: f32, make: impl Fn(&Gpu, &scene::Scene) -> MapTec
     let half_angle = degrees.to_radians();
     let light = LightShape::Distant { direction, half_angle };
     let technique = make(&gpu, &scene);
-    let vis = Visibility::new(&gpu, 160, 120, 1).unwrap();
+    let vis = VisibilityLayers::new(&gpu, 160, 120, 1).unwrap();
     gpu::render_visibility(&gpu, &technique, &Receivers::new(&gb, &points), &[light], &[], &vis).unwrap().remove(0);
     let v = vis.read(&gpu, 0).unwrap();
-    let truth = area_light_visibility(
-        &SceneBvh::new(&scene),
-        &points,
-        AreaLight::Cone { direction, half_angle },
-        32,
-        Weighting::Uniform,
-    );
+    let truth = area_light_visibility(&SceneBvh::new(&scene), &points, light, 32, Weighting::Uniform);
     let (mut sum, mut n, mut psum, mut pn) = (0.0, 0, 0.0, 0);
     for (a, b) in v.iter().zip(&truth) {
         let Some(b) = b else { continue };

@@ -24,4 +24,4 @@ pub use hierarchy::{
     BuildError, Kind, Occlusion, Receiver, Representative, Settings, ShaftHierarchy, ShaftNode, Transfers, Traversal,
 };
 pub use shaft::{Meet, Overlap, Plane, Shaft, meets};
-pub use tree::{Node, SourceShape, Tree, cone_directions, receiver_octree, source_tree};
+pub use tree::{Node, SourceShape, Tree, cone_direction_bounds, receiver_octree, source_tree};

@@ -9,7 +9,7 @@ use real_scene::formfactor::point_to_polygon;
 use real_scene::{RealScene, Visibility, luminance};
 use scene::DistantLight;
 
-use crate::{Aabb, BuildError, Receiver, Settings, ShaftHierarchy, SourceShape, Transfers, cone_directions};
+use crate::{Aabb, BuildError, Receiver, Settings, ShaftHierarchy, SourceShape, Transfers, cone_direction_bounds};
 
 /// A source of the source set.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -202,7 +202,7 @@ pub fn inputs(scene: &RealScene, lights: &[DistantLight], prepared: &Prepared) -
             Source::Patch(j) => SourceShape::Local(Aabb::from_points(scene.patches[j as usize].corners)),
             Source::Distant(k) => {
                 let l = &lights[k as usize];
-                SourceShape::Distant(cone_directions(l.direction, l.half_angle()))
+                SourceShape::Distant(cone_direction_bounds(l.direction, l.half_angle()))
             }
         })
         .collect();

@@ -242,7 +242,7 @@ pub fn receiver_octree(receivers: &[Aabb], leaf_size: usize) -> Tree {
 
 /// A box of unit directions within `half_angle` of `axis` (conservative: the cap's bounds).
 #[must_use]
-pub fn cone_directions(axis: Vec3, half_angle: f32) -> Aabb {
+pub fn cone_direction_bounds(axis: Vec3, half_angle: f32) -> Aabb {
     let a = axis.normalize();
     // the cap {d : d·a >= c}: per coordinate e, d·e ranges over cos(angle(a, e) ∓ half_angle)
     let mut min = Vec3::ZERO;

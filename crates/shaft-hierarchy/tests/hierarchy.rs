@@ -5,7 +5,7 @@ use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use shaft_hierarchy::{
     Aabb, BuildError, Kind, Occlusion, Receiver, Settings, ShaftHierarchy, SourceShape, Transfers, Traversal,
-    cone_directions,
+    cone_direction_bounds,
 };
 use trade::shafts::covered_pairs;
 
@@ -39,7 +39,7 @@ fn room(rng: &mut Pcg64, locals: usize, distant: usize, tiles: usize) -> Room {
         let axis =
             Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(0.2..1.0), rng.random_range(0.3..1.0)).normalize();
         let half_angle = rng.random_range(0.001..0.4f32);
-        sources.push(SourceShape::Distant(cone_directions(axis, half_angle)));
+        sources.push(SourceShape::Distant(cone_direction_bounds(axis, half_angle)));
         cones.push(Some(Cone { axis, half_angle }));
     }
     let mut receivers = Vec::new();

@@ -6,7 +6,7 @@ use std::time::Duration;
 
 use gpu::{Gpu, GpuError};
 
-use differential_composite::compositor::Frame;
+use differential_composite::compositor::FrameTransfers;
 use differential_composite::gpu::{FrameTimes, GpuCompositor, GpuSettings, MapWork};
 use differential_composite::ldr::Dataset;
 use differential_composite::{CodeError, Mode, SyntheticObject, code_error};
@@ -76,7 +76,7 @@ pub fn rows(
     let mut out = Vec::new();
     for &n in passes {
         for &mode in modes {
-            let mut runs: Vec<(Frame, Vec<[u8; 3]>, FrameTimes, MapWork)> = Vec::new();
+            let mut runs: Vec<(FrameTransfers, Vec<[u8; 3]>, FrameTimes, MapWork)> = Vec::new();
             for _ in 0..repeats.max(1) {
                 let frame = c.frame(object, n);
                 let (image, times, work) = gc.composite(gpu, c, &frame, object, mode, settings)?;
@@ -109,7 +109,7 @@ pub fn ms(d: Duration) -> f64 {
 /// non-zero transfers from the frame's occluded sources (one representative a source), those
 /// with the most radiance first, each with its `sources` largest transfers.
 #[must_use]
-pub fn figure3_datasets(session: &Session, frame: &Frame, count: usize, sources: usize) -> Vec<Dataset> {
+pub fn figure3_datasets(session: &Session, frame: &FrameTransfers, count: usize, sources: usize) -> Vec<Dataset> {
     let c = &session.compositor;
     let mut vertices: Vec<Dataset> = (0..c.prepared.transfers.slots)
         .filter_map(|s| {

@@ -13,7 +13,8 @@
 //! **Architecture invariant:** shadow techniques are reached only through
 //! `gpu::ShadowTechnique`, extraction only through `light_extract::extractor`, compositing only
 //! through `differential_composite`'s GPU compositor and its settings: a new technique adds a
-//! [`Shadow`] value and one line in [`measure::technique`], nothing else here changes. Families
+//! [`Shadow`] value and its [`TechniqueSpec`] (built by the one [`TechniqueBuilder`], which
+//! `validate` and the benches use too), nothing else here changes. Families
 //! never share a front or a choice (their errors are against different truths). Library code:
 //! no printing, progress goes to a callback.
 
@@ -22,6 +23,7 @@ pub mod capture;
 pub mod composite;
 pub mod composite_rows;
 pub mod front;
+pub mod lights;
 pub mod measure;
 pub mod offline;
 pub mod point;
@@ -31,6 +33,7 @@ pub mod setting;
 pub mod shafts;
 pub mod shard;
 pub mod table;
+pub mod techniques;
 
 pub use banding::{BandingCase, BandingRow, Interleave, measure_banding};
 pub use capture::{PhotoSettings, photograph, photograph_with};
@@ -39,9 +42,13 @@ pub use front::{ChooseError, Measurement, Point, choose, front as pareto_front, 
 pub use measure::{Case, Passes, Plan, measure};
 pub use point::{PointCase, measure_point};
 pub use session::{Session, SessionSettings};
-pub use setting::{CompositeSetting, EnvSetting, Family, PatchMaps, PointSetting, Preset, Setting, Shadow};
+pub use setting::{
+    CompositeSetting, EQUAL_TEXEL_SIDES, EnvSetting, Family, MapVariant, PatchMaps, PointSetting, Preset, Setting,
+    Shadow, equal_texel_variants,
+};
 pub use shard::{Shard, ShardError};
 pub use table::{Run, RunConfig, merge};
+pub use techniques::{TechniqueBuilder, TechniqueSpec, traced_visibility};
 
 use std::path::PathBuf;
 
@@ -56,8 +63,8 @@ pub enum TradeError {
         /// Why.
         source: std::io::Error,
     },
-    /// A JSON file that is not a trade run.
-    #[error("{path}: not a trade run: {message}")]
+    /// A JSON file that is not a run (of the trade or of `eval-lights`).
+    #[error("{path}: {message}")]
     Json {
         /// The file.
         path: PathBuf,
@@ -83,7 +90,7 @@ pub enum TradeError {
         what: String,
     },
     /// A merge of nothing.
-    #[error("nothing to merge: give at least one folder with a trade.json")]
+    #[error("nothing to merge: give at least one folder of a run (with its trade.json or eval-lights.json)")]
     NothingToMerge,
     /// An unknown scene.
     #[error("scene: {0}")]

@@ -14,10 +14,8 @@ use gpu::{
     SplitSettings,
 };
 use light_extract::Decomposition;
-use penumbra_wedge::{WedgeSettings, Wedges};
 use ref_tracer::metrics::{FlipTonemap, flip, rmse};
 use ref_tracer::{EnvLight, Integrator, RenderSettings, SceneBvh, Strategy};
-use shadowmap_paraboloid::MapTechnique;
 use std::cell::RefCell;
 use std::collections::HashMap;
 use std::rc::Rc;
@@ -114,7 +112,8 @@ impl Passes {
     }
 }
 
-/// The technique of `shadow` for `scene`, `None` for [`Shadow::None`].
+/// The technique of `shadow` for `scene`, `None` for [`Shadow::None`], from the one builder
+/// ([`crate::TechniqueBuilder`]).
 ///
 /// # Errors
 /// GPU failures.
@@ -123,12 +122,8 @@ pub fn technique(
     scene: &scene::Scene,
     shadow: &Shadow,
 ) -> Result<Option<Box<dyn ShadowTechnique>>, TradeError> {
-    if *shadow == Shadow::Wedges {
-        return Ok(Some(Box::new(Wedges::new(gpu, scene, WedgeSettings::default()))));
-    }
-    // every other technique but `None` is a map technique
-    Ok(match shadow.map_settings() {
-        Some((projection, settings, n)) => Some(Box::new(MapTechnique::new(gpu, scene, projection, settings, n)?)),
+    Ok(match shadow.spec() {
+        Some(spec) => Some(crate::TechniqueBuilder::new(gpu, scene).build(&spec)?),
         None => None,
     })
 }

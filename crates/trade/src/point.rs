@@ -14,7 +14,7 @@ use gpu::{
 };
 use ref_tracer::SceneBvh;
 use ref_tracer::metrics::{FlipTonemap, flip, rmse};
-use ref_tracer::visibility::{VisibilityLight, light_visibility};
+use ref_tracer::visibility::light_visibility;
 
 /// A built-in scene with point lights, and its truth.
 pub struct PointCase {
@@ -66,7 +66,7 @@ impl PointCase {
             .iter()
             .zip(&case.shapes)
             .map(|(l, shape)| {
-                let v = light_visibility(&bvh, &points, VisibilityLight::Point(l.position));
+                let v = light_visibility(&bvh, &points, LightShape::point(l.position));
                 (*shape, v.into_iter().map(|v| if v == Some(false) { 0.0 } else { 1.0 }).collect())
             })
             .collect();

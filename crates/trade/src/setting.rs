@@ -1,8 +1,10 @@
 //! Settings as data: one value names every knob of a frame, so the trade can be swept, stored,
 //! merged and chosen from without knowing the techniques behind it.
 
+use crate::techniques::TechniqueSpec;
+use penumbra_wedge::WedgeSettings;
 use serde::{Deserialize, Serialize};
-use shadowmap_paraboloid::{Pcss, ShadowSettings, Technique};
+use shadowmap_paraboloid::{Pcss, Rejection, ShadowSettings, Technique};
 
 /// How the extracted lights are shadowed on the GPU: each becomes a `gpu::ShadowTechnique`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -73,12 +75,12 @@ impl Shadow {
         }
     }
 
-    /// A map technique's projection, settings and maps per light (`None` for the others).
+    /// How to build this technique ([`crate::TechniqueBuilder`]), `None` for [`Shadow::None`].
     #[must_use]
-    pub fn map_settings(&self) -> Option<(Technique, ShadowSettings, u32)> {
+    pub fn spec(&self) -> Option<TechniqueSpec> {
         let base = ShadowSettings::default();
         let ortho = Technique::Orthographic;
-        match *self {
+        let maps = match *self {
             Shadow::Maps { resolution, pcf } => {
                 Some((ortho, ShadowSettings { resolution, pcf_radius: pcf, ..base }, 1))
             }
@@ -104,8 +106,10 @@ impl Shadow {
                 ShadowSettings { resolution, pcf_radius: pcf, subdivide_angle: None, ..base },
                 1,
             )),
-            Shadow::None | Shadow::Wedges => None,
-        }
+            Shadow::Wedges => return Some(TechniqueSpec::Wedges(WedgeSettings::default())),
+            Shadow::None => None,
+        };
+        maps.map(|(projection, settings, samples)| TechniqueSpec::Maps { projection, settings, samples })
     }
 
     /// Whether it shadows point lights (paraboloid and cube maps) rather than distant ones.
@@ -395,7 +399,7 @@ impl Preset {
                 }));
                 v.push(Setting::new("median-cut", 32, Shadow::Maps { resolution: 1024, pcf: 1 }));
                 // point lights: paraboloid and cube maps of equal texel counts (paper 004)
-                for (p, c) in shadowmap_paraboloid::EQUAL_TEXEL_SIDES {
+                for (p, c) in EQUAL_TEXEL_SIDES {
                     v.push(paraboloid(p, 0, true));
                     v.push(cube(c, 0));
                 }
@@ -419,4 +423,53 @@ impl Preset {
             }
         }
     }
+}
+
+/// Map sides with (nearly) equal texel counts: a dual paraboloid map of side `p` (2 p² texels)
+/// against a cube map of side `c` (6 c² texels), c = p / √3 rounded to a multiple of 8. The
+/// accuracy and speed comparisons use these pairs.
+pub const EQUAL_TEXEL_SIDES: [(u32, u32); 3] = [(512, 296), (1024, 592), (2048, 1184)];
+
+/// A named shadow-map configuration.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MapVariant {
+    /// Name, e.g. `paraboloid_1024_clip_subdivided`.
+    pub name: String,
+    /// The technique.
+    pub technique: Technique,
+    /// Its settings.
+    pub settings: ShadowSettings,
+}
+
+/// The paraboloid-against-cube comparison of the validate report and the bench: for each pair of
+/// [`EQUAL_TEXEL_SIDES`], the cube map and the dual paraboloid map with clip distances (plain and
+/// subdivided) and with a discard (subdivided).
+#[must_use]
+pub fn equal_texel_variants() -> Vec<MapVariant> {
+    let mut out = Vec::new();
+    for (p, c) in EQUAL_TEXEL_SIDES {
+        let base = ShadowSettings::default();
+        let variant = |name: String, technique, resolution, rejection, subdivide_angle| MapVariant {
+            name,
+            technique,
+            settings: ShadowSettings { resolution, rejection, subdivide_angle, ..base },
+        };
+        out.push(variant(format!("cube_{c}"), Technique::Cube, c, Rejection::ClipDistance, None));
+        out.push(variant(format!("paraboloid_{p}_clip"), Technique::DualParaboloid, p, Rejection::ClipDistance, None));
+        out.push(variant(
+            format!("paraboloid_{p}_clip_subdivided"),
+            Technique::DualParaboloid,
+            p,
+            Rejection::ClipDistance,
+            base.subdivide_angle,
+        ));
+        out.push(variant(
+            format!("paraboloid_{p}_discard_subdivided"),
+            Technique::DualParaboloid,
+            p,
+            Rejection::Discard,
+            base.subdivide_angle,
+        ));
+    }
+    out
 }

@@ -117,7 +117,7 @@ impl Run {
     pub fn write(&self, dir: &Path) -> Result<(), TradeError> {
         std::fs::create_dir_all(dir).map_err(|source| TradeError::Io { path: dir.to_path_buf(), source })?;
         let json = serde_json::to_string_pretty(self)
-            .map_err(|e| TradeError::Json { path: dir.join("trade.json"), message: e.to_string() })?;
+            .map_err(|e| TradeError::Json { path: dir.join("trade.json"), message: format!("not a trade run: {e}") })?;
         for (name, text) in [("trade.json", json), ("trade.csv", self.csv())] {
             let p = dir.join(name);
             std::fs::write(&p, text).map_err(|source| TradeError::Io { path: p, source })?;
@@ -132,7 +132,7 @@ impl Run {
     pub fn read(dir: &Path) -> Result<Self, TradeError> {
         let p = dir.join("trade.json");
         let text = std::fs::read_to_string(&p).map_err(|source| TradeError::Io { path: p.clone(), source })?;
-        serde_json::from_str(&text).map_err(|e| TradeError::Json { path: p, message: e.to_string() })
+        serde_json::from_str(&text).map_err(|e| TradeError::Json { path: p, message: format!("not a trade run: {e}") })
     }
 }
 

@@ -8,17 +8,15 @@ use envmap_sphere::EnvMap;
 use glam::Vec3;
 use gpu::{
     Background, FrameLights, FrameShadows, GBufferPass, Gpu, JointBilateral, LightShape, LitFrame, LitSettings,
-    PrecomputedVisibility, PrefilterSettings, Receivers, ReferenceReceivers, SceneGeometry, ShadeLight, ShadowGeometry,
-    ShadowTechnique, SpecularAmbient, SplitSettings, Visibility,
+    PrefilterSettings, Receivers, ReferenceReceivers, SceneGeometry, ShadeLight, ShadowGeometry, ShadowTechnique,
+    SpecularAmbient, SplitSettings, VisibilityLayers,
 };
-use penumbra_wedge::{WedgeSettings, Wedges};
+use penumbra_wedge::WedgeSettings;
 use ref_tracer::SceneBvh;
-use ref_tracer::visibility::{AreaLight, VisibilityLight, Weighting, area_light_visibility_refined, light_visibility};
-use shadowmap_paraboloid::{
-    MapTechnique, Pcss, ShadowLight, ShadowMapper, ShadowSettings, Technique, disagreement, equal_texel_variants,
-    shadow_triangles,
-};
+use ref_tracer::visibility::{disagreement, light_visibility};
+use shadowmap_paraboloid::{MapView, Pcss, ShadowMapper, ShadowSettings, Technique, shadow_triangles};
 use std::time::Instant;
+use trade::{TechniqueBuilder, TechniqueSpec, equal_texel_variants, traced_visibility};
 
 /// One GPU image: its row name, what it is (technique, lights shadowed and skipped, GPU time),
 /// the image and the seconds it took end to end.
@@ -35,58 +33,22 @@ pub(super) struct Passes {
     pub(super) shadows: ShadowMapper,
 }
 
-/// Ray-traced visibility of each light from the G-buffer's points (2 × 2 stratified directions,
-/// `n` × `n` in and next to penumbrae; pixels the light cannot reach stay lit).
-fn traced_visibility(
-    gpu: &Gpu,
-    scene: &scene::Scene,
-    receivers: &Receivers,
-    shapes: &[LightShape],
-    n: u32,
-) -> Result<PrecomputedVisibility, String> {
-    let bvh = SceneBvh::new(scene);
-    let layers = shapes
-        .iter()
-        .map(|s| {
-            let area = match *s {
-                LightShape::Distant { direction, half_angle } => AreaLight::Cone { direction, half_angle },
-                LightShape::Sphere { center, radius } => AreaLight::Sphere { center, radius },
-            };
-            let width = receivers.gbuffer.size().0 as usize;
-            // weighted by the cosine, as the shading needs it (`unshadowed irradiance x visibility`)
-            let v = area_light_visibility_refined(&bvh, receivers.points, area, width, (2, n), Weighting::Cosine);
-            (*s, v.into_iter().map(|v| v.unwrap_or(1.0)).collect())
-        })
-        .collect();
-    PrecomputedVisibility::new(
-        gpu,
-        &format!("ray-traced visibility ({n}x{n} directions)"),
-        receivers.gbuffer.size(),
-        layers,
-    )
-    .map_err(|e| e.to_string())
-}
-
 /// A row name and its shadow technique.
 type NamedTechnique = (String, Box<dyn ShadowTechnique>);
 
-/// The shadow techniques validate compares on the extracted lights, by row name.
+/// The shadow techniques validate compares on the extracted lights, by row name: the plan's
+/// hard maps, PCSS on them, the mean of `plan.multi_samples` maps of half the side, wedges.
 fn techniques(gpu: &Gpu, scene: &scene::Scene, plan: &Plan) -> Result<Vec<NamedTechnique>, String> {
-    let e = |e: gpu::GpuError| e.to_string();
     let hard = plan.shadow;
     let pcss = ShadowSettings { pcss: Some(Pcss::default()), pcf_radius: 0, ..hard };
     let multi = ShadowSettings { resolution: hard.resolution / 2, pcf_radius: 0, ..hard };
-    let maps = MapTechnique::new(gpu, scene, Technique::Orthographic, hard, 1).map_err(e)?;
-    let (pcss, multi) = (
-        maps.variant(Technique::Orthographic, pcss, 1),
-        maps.variant(Technique::Orthographic, multi, plan.multi_samples),
-    );
-    Ok(vec![
-        ("gpu_shadow_maps".into(), Box::new(maps)),
-        ("gpu_pcss".into(), Box::new(pcss)),
-        (format!("gpu_shadow_maps_x{}", plan.multi_samples), Box::new(multi)),
-        ("gpu_wedges".into(), Box::new(Wedges::new(gpu, scene, WedgeSettings::default()))),
-    ])
+    let specs = [
+        ("gpu_shadow_maps".to_string(), TechniqueSpec::orthographic(hard, 1)),
+        ("gpu_pcss".into(), TechniqueSpec::orthographic(pcss, 1)),
+        (format!("gpu_shadow_maps_x{}", plan.multi_samples), TechniqueSpec::orthographic(multi, plan.multi_samples)),
+        ("gpu_wedges".into(), TechniqueSpec::Wedges(WedgeSettings::default())),
+    ];
+    TechniqueBuilder::new(gpu, scene).build_all(&specs).map_err(|e| e.to_string())
 }
 
 /// The extracted lights on the GPU with every technique of [`techniques`], and without shadows
@@ -147,7 +109,7 @@ pub(super) fn gpu_render(
     let mut all = techniques(gpu, scene, plan)?;
     all.push((
         "gpu_traced_visibility".into(),
-        Box::new(traced_visibility(gpu, scene, &receivers, &shapes, plan.truth_directions)?),
+        Box::new(traced_visibility(gpu, scene, &receivers, &shapes, plan.truth_directions).map_err(e)?),
     ));
     for (name, technique) in &all {
         let t = Instant::now();
@@ -301,12 +263,12 @@ pub(super) fn room_masks(
     let gb = passes.gbuffer.render(gpu, &geometry, &scene.camera).map_err(e)?;
     let points = gb.read_points(gpu).map_err(e)?;
     let position = scene.point_lights[0].position;
-    let truth = light_visibility(&SceneBvh::new(&scene), &points, VisibilityLight::Point(position));
+    let truth = light_visibility(&SceneBvh::new(&scene), &points, LightShape::point(position));
     let tris = gpu::scene_triangles(&scene);
-    let light = ShadowLight::omni(position);
+    let light = MapView::omni(position);
     let mapper = &passes.shadows;
     let (w, h) = plan.room_size;
-    let vis = Visibility::new(gpu, w, h, 1).map_err(e)?;
+    let vis = VisibilityLayers::new(gpu, w, h, 1).map_err(e)?;
     let mut rows = Vec::new();
     let (mut paraboloid_mask, mut cube_mask) = (Vec::new(), Vec::new());
     let mut clock = gpu::Clock::WallTime;
