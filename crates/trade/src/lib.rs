@@ -32,6 +32,7 @@ pub mod session;
 pub mod setting;
 pub mod shafts;
 pub mod shard;
+pub mod stages;
 pub mod table;
 pub mod techniques;
 

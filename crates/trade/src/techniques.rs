@@ -35,6 +35,12 @@ impl TechniqueSpec {
     pub fn orthographic(settings: ShadowSettings, samples: u32) -> Self {
         Self::Maps { projection: Technique::Orthographic, settings, samples }
     }
+
+    /// Penumbra wedges with their default knobs.
+    #[must_use]
+    pub fn wedges() -> Self {
+        Self::Wedges(WedgeSettings::default())
+    }
 }
 
 /// Makes the techniques of one scene. Map techniques share one set of pipelines and shadow

@@ -7,22 +7,20 @@
 
 mod banding_stage;
 mod composite_stage;
-mod gpu_stages;
 mod readme;
 mod report;
 
 use crate::common::load_map;
 use crate::thresholds::load_thresholds;
 use glam::Vec3;
-use gpu::GBufferPass;
-use gpu_stages::{MaskImages, Passes, SizeRow, gpu_render, room_masks};
 use ref_tracer::metrics::{FlipTonemap, flip, rmse};
 use ref_tracer::{EnvLight, Integrator, LightSet, RenderSettings, SceneBvh, Strategy};
 use report::Report;
-use shadowmap_paraboloid::{ShadowMapper, ShadowSettings, Technique};
+use shadowmap_paraboloid::ShadowSettings;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::time::Instant;
+use trade::stages::{StagePasses, StagePlan, gpu_render, room_masks};
 
 /// Options of `cargo xtask validate`.
 #[derive(clap::Parser, Clone, Debug)]
@@ -98,6 +96,19 @@ struct Plan {
 }
 
 impl Plan {
+    /// What the GPU stages (`trade::stages`) take of the plan.
+    fn stages(&self) -> StagePlan {
+        StagePlan {
+            shadow: self.shadow,
+            multi_samples: self.multi_samples,
+            truth_directions: self.truth_directions,
+            gpu_supersample: self.gpu_supersample,
+            interleaved: self.interleaved,
+            room_size: self.room_size,
+            repeats: self.repeats,
+        }
+    }
+
     fn new(quick: bool) -> Self {
         let shadow = ShadowSettings { resolution: 2048, pcf_radius: 1, ..ShadowSettings::default() };
         if quick {
@@ -165,16 +176,6 @@ struct Row {
     rmse_vs_lights: Option<f64>,
 }
 
-/// One point-light shadow-map measurement.
-struct MaskRow {
-    name: String,
-    technique: Technique,
-    texels: u64,
-    disagreement: f64,
-    gpu_ms: f64,
-    triangles: u32,
-}
-
 struct Stages {
     total: usize,
     done: usize,
@@ -240,8 +241,9 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
     let traced_s = t.elapsed().as_secs_f64();
 
     stages.next(&format!("GPU: G-buffer, shadow techniques (maps, PCSS, N maps, wedges), shading ({})", gpu.info.name));
-    let passes = Passes { gbuffer: GBufferPass::new(&gpu), shadows: ShadowMapper::new(&gpu) };
-    let gpu_images = gpu_render(&gpu, &passes, &scene, &map, &decomposition, &plan)?;
+    let passes = StagePasses::new(&gpu);
+    let gpu_images =
+        gpu_render(&gpu, &passes, &scene, &map, &decomposition, &plan.stages()).map_err(|e| e.to_string())?;
 
     // paper 001's Figure 1: env-direct given the time the GPU's split frame took, here
     let equal_time = gpu_images.iter().find(|g| g.name == "gpu_wedges_indirects_half").map(|g| g.seconds);
@@ -264,7 +266,8 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
     });
 
     stages.next("room: point-light shadow maps against ray-traced visibility, and their speed");
-    let (mask_rows, mask_images, size_rows, clock) = room_masks(&gpu, &passes, &plan)?;
+    let (mask_rows, mask_images, size_rows, clock) =
+        room_masks(&gpu, &passes, &plan.stages()).map_err(|e| e.to_string())?;
 
     stages.next("compositing: a sphere into ar_ground's photograph, against the truth and Debevec's method");
     let compositing = composite_stage::run(&gpu, args.quick)?;

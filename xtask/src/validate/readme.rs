@@ -8,9 +8,10 @@
 //! rasterizes differently). Times are never checked: they are one run's, and so is the error of
 //! the equal-time row.
 
-use super::{MaskRow, Row};
+use super::Row;
 use std::fmt::Write as _;
 use std::path::Path;
+use trade::stages::MaskRow;
 
 const BEGIN: &str = "<!-- validate:begin";
 const END: &str = "<!-- validate:end -->";

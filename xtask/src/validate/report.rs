@@ -1,7 +1,7 @@
 //! The validate report: a self-contained HTML page with every image, error map, table and the
 //! adapter and driver used.
 
-use super::{MaskImages, MaskRow, Plan, Row, SizeRow};
+use super::{Plan, Row};
 use envmap_sphere::Tonemap;
 use glam::Vec3;
 use gpu::Gpu;
@@ -9,6 +9,7 @@ use ref_tracer::metrics::FlipTonemap;
 use shadowmap_paraboloid::Technique;
 use std::fmt::Write as _;
 use std::path::Path;
+use trade::stages::{MaskImages, MaskRow, SizeRow};
 
 pub(super) struct Report<'a> {
     pub(super) gpu: &'a Gpu,

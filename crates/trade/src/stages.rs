@@ -1,9 +1,11 @@
-//! The GPU stages of `validate`: the extracted lights on `spheres_box` (or the given scene)
-//! shadowed by every technique (shadow maps, PCSS, N-sample maps, penumbra wedges) through
-//! `gpu::ShadowTechnique`, and the `room` point light's paraboloid and cube maps against
-//! ray-traced visibility.
+//! The GPU stages `cargo xtask validate` measures: the extracted lights on `spheres_box` (or the
+//! given scene) shadowed by every technique (shadow maps, PCSS, N-sample maps, penumbra wedges,
+//! the traced truth) through `gpu::ShadowTechnique` and drawn by `gpu::LitFrame`, paper 001's
+//! split and interleaved frames, and the `room` point light's paraboloid and cube maps against
+//! ray-traced visibility. `validate` compares the images with the reference and prints.
 
-use super::{MaskRow, Plan};
+use crate::TradeError;
+use crate::{TechniqueBuilder, TechniqueSpec, equal_texel_variants, traced_visibility};
 use envmap_sphere::EnvMap;
 use glam::Vec3;
 use gpu::{
@@ -11,26 +13,74 @@ use gpu::{
     PrefilterSettings, Receivers, ReferenceReceivers, SceneGeometry, ShadeLight, ShadowGeometry, ShadowTechnique,
     SpecularAmbient, SplitSettings, VisibilityLayers,
 };
-use penumbra_wedge::WedgeSettings;
 use ref_tracer::SceneBvh;
 use ref_tracer::visibility::{disagreement, light_visibility};
 use shadowmap_paraboloid::{MapView, Pcss, ShadowMapper, ShadowSettings, Technique, shadow_triangles};
 use std::time::Instant;
-use trade::{TechniqueBuilder, TechniqueSpec, equal_texel_variants, traced_visibility};
 
 /// One GPU image: its row name, what it is (technique, lights shadowed and skipped, GPU time),
 /// the image and the seconds it took end to end.
-pub(super) struct GpuImage {
-    pub(super) name: String,
-    pub(super) what: String,
-    pub(super) image: Vec<Vec3>,
-    pub(super) seconds: f64,
+pub struct GpuImage {
+    /// Row name, e.g. `gpu_wedges`.
+    pub name: String,
+    /// What it is: technique, lights shadowed and skipped, GPU time.
+    pub what: String,
+    /// The image, resolved to the plan's size.
+    pub image: Vec<Vec3>,
+    /// Seconds end to end.
+    pub seconds: f64,
+}
+
+/// What the stages draw and how.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StagePlan {
+    /// The hard maps; PCSS and the N-sample maps derive from them.
+    pub shadow: ShadowSettings,
+    /// Maps per light of the N-sample technique (at half the resolution).
+    pub multi_samples: u32,
+    /// Ray-traced visibility of the truth row: n × n directions per pixel and light.
+    pub truth_directions: u32,
+    /// GPU images supersampled on a rotated grid of k² + 1 samples per pixel, box-filtered.
+    pub gpu_supersample: u32,
+    /// Rows of interleaved light sets too.
+    pub interleaved: bool,
+    /// Size of the `room` frames.
+    pub room_size: (u32, u32),
+    /// Renders per map variant (the median time is kept).
+    pub repeats: usize,
+}
+
+/// One shadow map of the `room` comparison against ray-traced visibility.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaskRow {
+    /// The variant's name ([`crate::MapVariant`]).
+    pub name: String,
+    /// Its projection.
+    pub technique: Technique,
+    /// Texels of all its views.
+    pub texels: u64,
+    /// Fraction of the pixels whose lit test disagrees with the truth.
+    pub disagreement: f64,
+    /// Median GPU time of the map, ms.
+    pub gpu_ms: f64,
+    /// Triangles drawn into it.
+    pub triangles: u32,
 }
 
 /// The GPU passes, built once per run.
-pub(super) struct Passes {
-    pub(super) gbuffer: GBufferPass,
-    pub(super) shadows: ShadowMapper,
+pub struct StagePasses {
+    /// The G-buffer pass.
+    pub gbuffer: GBufferPass,
+    /// The shadow mapper of the `room` maps.
+    pub shadows: ShadowMapper,
+}
+
+impl StagePasses {
+    /// The passes on `gpu`.
+    #[must_use]
+    pub fn new(gpu: &Gpu) -> Self {
+        Self { gbuffer: GBufferPass::new(gpu), shadows: ShadowMapper::new(gpu) }
+    }
 }
 
 /// A row name and its shadow technique.
@@ -38,7 +88,7 @@ type NamedTechnique = (String, Box<dyn ShadowTechnique>);
 
 /// The shadow techniques validate compares on the extracted lights, by row name: the plan's
 /// hard maps, PCSS on them, the mean of `plan.multi_samples` maps of half the side, wedges.
-fn techniques(gpu: &Gpu, scene: &scene::Scene, plan: &Plan) -> Result<Vec<NamedTechnique>, String> {
+fn techniques(gpu: &Gpu, scene: &scene::Scene, plan: &StagePlan) -> Result<Vec<NamedTechnique>, TradeError> {
     let hard = plan.shadow;
     let pcss = ShadowSettings { pcss: Some(Pcss::default()), pcf_radius: 0, ..hard };
     let multi = ShadowSettings { resolution: hard.resolution / 2, pcf_radius: 0, ..hard };
@@ -46,24 +96,28 @@ fn techniques(gpu: &Gpu, scene: &scene::Scene, plan: &Plan) -> Result<Vec<NamedT
         ("gpu_shadow_maps".to_string(), TechniqueSpec::orthographic(hard, 1)),
         ("gpu_pcss".into(), TechniqueSpec::orthographic(pcss, 1)),
         (format!("gpu_shadow_maps_x{}", plan.multi_samples), TechniqueSpec::orthographic(multi, plan.multi_samples)),
-        ("gpu_wedges".into(), TechniqueSpec::Wedges(WedgeSettings::default())),
+        ("gpu_wedges".into(), TechniqueSpec::wedges()),
     ];
-    TechniqueBuilder::new(gpu, scene).build_all(&specs).map_err(|e| e.to_string())
+    Ok(TechniqueBuilder::new(gpu, scene).build_all(&specs)?)
 }
 
 /// The extracted lights on the GPU with every technique of [`techniques`], and without shadows
 /// (the last image), each frame the toolkit's recorded frame ([`gpu::LitFrame`]) with its
 /// receivers read back and reduced on the CPU ([`ReferenceReceivers::CpuPoints`]): the
 /// reference its GPU-gated frame is tested against, waited for and its lights timed.
-pub(super) fn gpu_render(
+/// The extracted lights of `d` on `scene` lit by `map`, one image per technique and frame
+/// kind, the last without shadows.
+///
+/// # Errors
+/// GPU failures.
+pub fn gpu_render(
     gpu: &Gpu,
-    passes: &Passes,
+    passes: &StagePasses,
     scene: &scene::Scene,
     map: &EnvMap,
     d: &light_extract::Decomposition,
-    plan: &Plan,
-) -> Result<Vec<GpuImage>, String> {
-    let e = |e: gpu::GpuError| e.to_string();
+    plan: &StagePlan,
+) -> Result<Vec<GpuImage>, TradeError> {
     let start = Instant::now();
     // supersampled as the ray tracer's pixels are (box filter): edges alias otherwise, and
     // their error would hide the shadows'. A rotated grid: an ordered one quantizes the
@@ -73,23 +127,20 @@ pub(super) fn gpu_render(
     let mut scene = scene.clone();
     scene.camera = *grid.camera();
     let scene = &scene;
-    let geometry = SceneGeometry::upload(gpu, scene).map_err(e)?;
+    let geometry = SceneGeometry::upload(gpu, scene)?;
     // the ray-traced truth's receivers: its rays start from the G-buffer's points
-    let gb = passes.gbuffer.render(gpu, &geometry, &scene.camera).map_err(e)?;
-    let points = gb.read_points(gpu).map_err(e)?;
+    let gb = passes.gbuffer.render(gpu, &geometry, &scene.camera)?;
+    let points = gb.read_points(gpu)?;
     let receivers = Receivers::new(&gb, &points);
     let lights: Vec<ShadeLight> = d.lights.iter().map(|l| ShadeLight::from(&l.light)).collect();
     let shapes: Vec<LightShape> = d.lights.iter().map(|l| LightShape::from(&l.light)).collect();
-    let lit = LitFrame::new(gpu, gb.size()).map_err(e)?;
+    let lit = LitFrame::new(gpu, gb.size())?;
     let view = GBufferPass::camera_view(&geometry, &scene.camera);
-    let background = Background::upload(gpu, map).map_err(e)?;
+    let background = Background::upload(gpu, map)?;
     // the ambient map on the specular lobe, for scenes that have one
     let glossy = scene.objects.iter().any(|o| o.material.specular.is_some());
-    let specular = if glossy {
-        Some(SpecularAmbient::new(gpu, &d.ambient, &PrefilterSettings::default()).map_err(e)?)
-    } else {
-        None
-    };
+    let specular =
+        if glossy { Some(SpecularAmbient::new(gpu, &d.ambient, &PrefilterSettings::default())?) } else { None };
     let ambient = match &specular {
         Some(_) => "SH9 + prefiltered specular ambient",
         None => "SH9 ambient (no glossy surface: no specular prefiltering)",
@@ -109,14 +160,13 @@ pub(super) fn gpu_render(
     let mut all = techniques(gpu, scene, plan)?;
     all.push((
         "gpu_traced_visibility".into(),
-        Box::new(traced_visibility(gpu, scene, &receivers, &shapes, plan.truth_directions).map_err(e)?),
+        Box::new(traced_visibility(gpu, scene, &receivers, &shapes, plan.truth_directions)?),
     ));
     for (name, technique) in &all {
         let t = Instant::now();
         let shadows = FrameShadows { direct: technique.as_ref(), indirect: technique.as_ref() };
-        let frame = lit
-            .render_reference(gpu, &geometry, &view, &whole, shadows, &settings, ReferenceReceivers::CpuPoints)
-            .map_err(e)?;
+        let frame =
+            lit.render_reference(gpu, &geometry, &view, &whole, shadows, &settings, ReferenceReceivers::CpuPoints)?;
         let (image, reports) = finished(gpu, frame, technique.as_ref())?;
         let (time, shadowed, _, _) = gpu::totals(&reports);
         let shadow_ms = time.as_secs_f64() * 1e3;
@@ -147,17 +197,15 @@ pub(super) fn gpu_render(
         ] {
             let t = Instant::now();
             let settings = LitSettings { split: SplitSettings { indirect_scale: scale * ss, upsample }, ..settings };
-            let frame = lit
-                .render_reference(
-                    gpu,
-                    &geometry,
-                    &view,
-                    &split_lights,
-                    shadows,
-                    &settings,
-                    ReferenceReceivers::CpuPoints,
-                )
-                .map_err(e)?;
+            let frame = lit.render_reference(
+                gpu,
+                &geometry,
+                &view,
+                &split_lights,
+                shadows,
+                &settings,
+                ReferenceReceivers::CpuPoints,
+            )?;
             let (image, reports) = finished(gpu, frame, technique.as_ref())?;
             let direct_ms = gpu::totals(&reports[..directs]).0.as_secs_f64() * 1e3;
             let indirect_ms = gpu::totals(&reports[directs..]).0.as_secs_f64() * 1e3;
@@ -188,21 +236,19 @@ pub(super) fn gpu_render(
         for (name, technique) in all.iter().filter(|(n, _)| n == "gpu_shadow_maps" || n == "gpu_wedges") {
             let t = Instant::now();
             let shadows = FrameShadows { direct: technique.as_ref(), indirect: technique.as_ref() };
-            let interleaved = lit
-                .render_interleaved(
-                    gpu,
-                    &geometry,
-                    &view,
-                    &frames,
-                    shadows,
-                    &settings,
-                    Some(ReferenceReceivers::CpuPoints),
-                )
-                .map_err(e)?;
-            gpu.wait(None).map_err(e)?;
-            let (texture, reports) = interleaved.finish_reports(gpu).map_err(e)?;
+            let interleaved = lit.render_interleaved(
+                gpu,
+                &geometry,
+                &view,
+                &frames,
+                shadows,
+                &settings,
+                Some(ReferenceReceivers::CpuPoints),
+            )?;
+            gpu.wait(None)?;
+            let (texture, reports) = interleaved.finish_reports(gpu)?;
             let ms = gpu::totals(&reports).0.as_secs_f64() * 1e3;
-            let image = gpu::read_hdr(gpu, &texture).map_err(e)?;
+            let image = gpu::read_hdr(gpu, &texture)?;
             out.push(GpuImage {
                 name: format!("{name}_interleaved"),
                 what: format!(
@@ -218,13 +264,13 @@ pub(super) fn gpu_render(
             });
         }
     }
-    let frame = lit.render(gpu, &geometry, &view, &whole, None, &settings).map_err(e)?;
-    gpu.wait(None).map_err(e)?;
-    let (texture, _) = frame.finish_reports(gpu).map_err(e)?;
+    let frame = lit.render(gpu, &geometry, &view, &whole, None, &settings)?;
+    gpu.wait(None)?;
+    let (texture, _) = frame.finish_reports(gpu)?;
     out.push(GpuImage {
         name: "gpu_unshadowed".into(),
         what: "GPU: the same lights without shadows".into(),
-        image: grid.resolve(&gpu::read_hdr(gpu, &texture).map_err(e)?),
+        image: grid.resolve(&gpu::read_hdr(gpu, &texture)?),
         seconds: 0.0,
     });
     Ok(out)
@@ -236,12 +282,11 @@ fn finished(
     gpu: &Gpu,
     mut frame: gpu::RenderedFrame,
     technique: &dyn ShadowTechnique,
-) -> Result<(Vec<Vec3>, Vec<gpu::ShadowPassReport>), String> {
-    let e = |e: gpu::GpuError| e.to_string();
-    gpu.wait(None).map_err(e)?;
-    technique.read_counts(gpu, &mut frame.reports).map_err(e)?;
-    let (texture, reports) = frame.finish_reports(gpu).map_err(e)?;
-    Ok((gpu::read_hdr(gpu, &texture).map_err(e)?, reports))
+) -> Result<(Vec<Vec3>, Vec<gpu::ShadowPassReport>), TradeError> {
+    gpu.wait(None)?;
+    technique.read_counts(gpu, &mut frame.reports)?;
+    let (texture, reports) = frame.finish_reports(gpu)?;
+    Ok((gpu::read_hdr(gpu, &texture)?, reports))
 }
 
 /// ", N skipped: why" per reason, or nothing.
@@ -249,45 +294,51 @@ fn skip_summary(reports: &[gpu::ShadowPassReport]) -> String {
     gpu::skip_reasons(reports).iter().map(|(why, n)| format!(", {n} skipped: {why}")).collect()
 }
 
-pub(super) type MaskImages = (Vec<f32>, Vec<f32>, Vec<Option<bool>>, (u32, u32));
+/// The paraboloid and cube masks the report shows, the truth and their size.
+pub type MaskImages = (Vec<f32>, Vec<f32>, Vec<Option<bool>>, (u32, u32));
 
-pub(super) fn room_masks(
+/// The `room` point light's maps of equal texel counts ([`crate::equal_texel_variants`])
+/// against ray-traced visibility, the error against the angle triangles span (the paper's
+/// caveat), and the clock the times come from.
+///
+/// # Errors
+/// GPU failures.
+pub fn room_masks(
     gpu: &Gpu,
-    passes: &Passes,
-    plan: &Plan,
-) -> Result<(Vec<MaskRow>, MaskImages, Vec<SizeRow>, gpu::Clock), String> {
-    let e = |e: gpu::GpuError| e.to_string();
-    let mut scene = scene::Scene::builtin("room").map_err(|e| e.to_string())?;
+    passes: &StagePasses,
+    plan: &StagePlan,
+) -> Result<(Vec<MaskRow>, MaskImages, Vec<SizeRow>, gpu::Clock), TradeError> {
+    let mut scene = scene::Scene::builtin("room").map_err(|e| TradeError::Scene(e.to_string()))?;
     (scene.camera.width, scene.camera.height) = plan.room_size;
-    let geometry = SceneGeometry::upload(gpu, &scene).map_err(e)?;
-    let gb = passes.gbuffer.render(gpu, &geometry, &scene.camera).map_err(e)?;
-    let points = gb.read_points(gpu).map_err(e)?;
+    let geometry = SceneGeometry::upload(gpu, &scene)?;
+    let gb = passes.gbuffer.render(gpu, &geometry, &scene.camera)?;
+    let points = gb.read_points(gpu)?;
     let position = scene.point_lights[0].position;
     let truth = light_visibility(&SceneBvh::new(&scene), &points, LightShape::point(position));
     let tris = gpu::scene_triangles(&scene);
     let light = MapView::omni(position);
     let mapper = &passes.shadows;
     let (w, h) = plan.room_size;
-    let vis = VisibilityLayers::new(gpu, w, h, 1).map_err(e)?;
+    let vis = VisibilityLayers::new(gpu, w, h, 1)?;
     let mut rows = Vec::new();
     let (mut paraboloid_mask, mut cube_mask) = (Vec::new(), Vec::new());
     let mut clock = gpu::Clock::WallTime;
     for v in equal_texel_variants() {
         let (technique, settings) = (v.technique, v.settings);
         let t = shadow_triangles(&tris, &light, technique, &settings);
-        let g = ShadowGeometry::upload(gpu, &t, ShadowGeometry::CHUNK_TRIANGLES).map_err(e)?;
+        let g = ShadowGeometry::upload(gpu, &t, ShadowGeometry::CHUNK_TRIANGLES)?;
         let mut times = Vec::new();
         let mut last = None;
         for _ in 0..plan.repeats.max(1) {
-            let m = mapper.render(gpu, &g, &light, technique, &settings).map_err(e)?;
+            let m = mapper.render(gpu, &g, &light, technique, &settings)?;
             times.push(m.time.as_secs_f64() * 1e3);
             clock = m.clock;
             last = Some(m);
         }
         times.sort_by(f64::total_cmp);
-        let m = last.ok_or("no shadow map")?;
-        mapper.visibility(gpu, &m, &gb, &vis.layer(0)).map_err(e)?;
-        let mask = vis.read(gpu, 0).map_err(e)?;
+        let m = last.ok_or_else(|| TradeError::Render("no shadow map".into()))?;
+        mapper.visibility(gpu, &m, &gb, &vis.layer(0))?;
+        let mask = vis.read(gpu, 0)?;
         let (frac, _) = disagreement(&mask, &truth);
         if v.name == "paraboloid_1024_clip_subdivided" {
             paraboloid_mask = mask;
@@ -309,18 +360,21 @@ pub(super) fn room_masks(
         let settings = ShadowSettings { subdivide_angle: angle, ..ShadowSettings::default() };
         let t = shadow_triangles(&tris, &light, Technique::DualParaboloid, &settings);
         let widest = shadowmap_paraboloid::subdivide::max_edge_angle(&t, position);
-        let g = ShadowGeometry::upload(gpu, &t, ShadowGeometry::CHUNK_TRIANGLES).map_err(e)?;
-        let m = mapper.render(gpu, &g, &light, Technique::DualParaboloid, &settings).map_err(e)?;
-        mapper.visibility(gpu, &m, &gb, &vis.layer(0)).map_err(e)?;
-        let (frac, _) = disagreement(&vis.read(gpu, 0).map_err(e)?, &truth);
+        let g = ShadowGeometry::upload(gpu, &t, ShadowGeometry::CHUNK_TRIANGLES)?;
+        let m = mapper.render(gpu, &g, &light, Technique::DualParaboloid, &settings)?;
+        mapper.visibility(gpu, &m, &gb, &vis.layer(0))?;
+        let (frac, _) = disagreement(&vis.read(gpu, 0)?, &truth);
         sizes.push(SizeRow { widest, triangles: t.len(), disagreement: frac });
     }
     Ok((rows, (paraboloid_mask, cube_mask, truth, plan.room_size), sizes, clock))
 }
 
 /// One row of the error-against-triangle-size sweep.
-pub(super) struct SizeRow {
-    pub(super) widest: f32,
-    pub(super) triangles: usize,
-    pub(super) disagreement: f64,
+pub struct SizeRow {
+    /// The widest angle an edge spans from the light, radians.
+    pub widest: f32,
+    /// Triangles drawn.
+    pub triangles: usize,
+    /// Fraction of the pixels that disagree with the truth.
+    pub disagreement: f64,
 }
