@@ -58,7 +58,7 @@ pub struct ShadowMap {
     pub views: Vec<ShadowView>,
     /// The technique.
     pub technique: Technique,
-    /// The light.
+    /// The view it was drawn from.
     pub light: MapView,
     /// The paraboloid frame, for paraboloid maps.
     pub frame: Option<ParaboloidFrame>,

@@ -61,12 +61,10 @@ impl PointCase {
         let points = gb.read_points(gpu)?;
         let bvh = SceneBvh::new(&case.scene);
         let layers = case
-            .scene
-            .point_lights
+            .shapes
             .iter()
-            .zip(&case.shapes)
-            .map(|(l, shape)| {
-                let v = light_visibility(&bvh, &points, LightShape::point(l.position));
+            .map(|shape| {
+                let v = light_visibility(&bvh, &points, *shape);
                 (*shape, v.into_iter().map(|v| if v == Some(false) { 0.0 } else { 1.0 }).collect())
             })
             .collect();

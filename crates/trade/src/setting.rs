@@ -2,7 +2,6 @@
 //! merged and chosen from without knowing the techniques behind it.
 
 use crate::techniques::TechniqueSpec;
-use penumbra_wedge::WedgeSettings;
 use serde::{Deserialize, Serialize};
 use shadowmap_paraboloid::{Pcss, Rejection, ShadowSettings, Technique};
 
@@ -79,18 +78,20 @@ impl Shadow {
     #[must_use]
     pub fn spec(&self) -> Option<TechniqueSpec> {
         let base = ShadowSettings::default();
-        let ortho = Technique::Orthographic;
-        let maps = match *self {
+        let maps = |projection, settings, samples| Some(TechniqueSpec::Maps { projection, settings, samples });
+        match *self {
             Shadow::Maps { resolution, pcf } => {
-                Some((ortho, ShadowSettings { resolution, pcf_radius: pcf, ..base }, 1))
+                TechniqueSpec::orthographic(ShadowSettings { resolution, pcf_radius: pcf, ..base }, 1).into()
             }
-            Shadow::Pcss { resolution } => {
-                Some((ortho, ShadowSettings { resolution, pcf_radius: 0, pcss: Some(Pcss::default()), ..base }, 1))
-            }
+            Shadow::Pcss { resolution } => TechniqueSpec::orthographic(
+                ShadowSettings { resolution, pcf_radius: 0, pcss: Some(Pcss::default()), ..base },
+                1,
+            )
+            .into(),
             Shadow::MultiSample { n, resolution } => {
-                Some((ortho, ShadowSettings { resolution, pcf_radius: 0, ..base }, n))
+                TechniqueSpec::orthographic(ShadowSettings { resolution, pcf_radius: 0, ..base }, n).into()
             }
-            Shadow::Paraboloid { resolution, pcf, subdivide } => Some((
+            Shadow::Paraboloid { resolution, pcf, subdivide } => maps(
                 Technique::DualParaboloid,
                 ShadowSettings {
                     resolution,
@@ -99,17 +100,14 @@ impl Shadow {
                     ..base
                 },
                 1,
-            )),
+            ),
             // cube faces are perspective views: straight edges stay straight
-            Shadow::Cube { resolution, pcf } => Some((
-                Technique::Cube,
-                ShadowSettings { resolution, pcf_radius: pcf, subdivide_angle: None, ..base },
-                1,
-            )),
-            Shadow::Wedges => return Some(TechniqueSpec::Wedges(WedgeSettings::default())),
+            Shadow::Cube { resolution, pcf } => {
+                maps(Technique::Cube, ShadowSettings { resolution, pcf_radius: pcf, subdivide_angle: None, ..base }, 1)
+            }
+            Shadow::Wedges => Some(TechniqueSpec::wedges()),
             Shadow::None => None,
-        };
-        maps.map(|(projection, settings, samples)| TechniqueSpec::Maps { projection, settings, samples })
+        }
     }
 
     /// Whether it shadows point lights (paraboloid and cube maps) rather than distant ones.

@@ -67,14 +67,11 @@ impl<'a> TechniqueBuilder<'a> {
         Ok(match *spec {
             TechniqueSpec::Wedges(settings) => Box::new(Wedges::new(self.gpu, self.scene, settings)),
             TechniqueSpec::Maps { projection, settings, samples } => {
-                if let Some(maps) = &self.maps {
-                    Box::new(maps.variant(projection, settings, samples))
-                } else {
-                    let maps = MapTechnique::new(self.gpu, self.scene, projection, settings, samples)?;
-                    let out = maps.variant(projection, settings, samples);
-                    self.maps = Some(maps);
-                    Box::new(out)
-                }
+                let maps = match &mut self.maps {
+                    Some(maps) => maps,
+                    none => none.insert(MapTechnique::new(self.gpu, self.scene, projection, settings, samples)?),
+                };
+                Box::new(maps.variant(projection, settings, samples))
             }
         })
     }
