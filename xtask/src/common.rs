@@ -3,6 +3,7 @@
 //! internals; `tests/architecture.rs` checks the tree).
 
 use envmap_sphere::EnvMap;
+use glam::Vec3;
 use real_scene::RealScene;
 use std::path::Path;
 
@@ -28,3 +29,13 @@ pub fn environment(scene: &RealScene) -> Result<(Option<EnvMap>, Vec<scene::Dist
 
 /// Writes an image (name, size, 8-bit RGB) and returns its `<img>` element.
 pub type WritePng<'a> = dyn Fn(&str, (u32, u32), &[u8]) -> Result<String, String> + 'a;
+
+/// "X,Y,Z": three finite numbers.
+pub fn parse_vec3(s: &str) -> Result<Vec3, String> {
+    let v: Vec<f32> =
+        s.split(',').map(|x| x.trim().parse::<f32>()).collect::<Result<_, _>>().map_err(|e| format!("{s:?}: {e}"))?;
+    match v.as_slice() {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(Vec3::new(*x, *y, *z)),
+        _ => Err(format!("{s:?}: three finite numbers X,Y,Z")),
+    }
+}

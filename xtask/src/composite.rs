@@ -78,19 +78,6 @@ pub struct CompositeArgs {
     pub adapter: Option<String>,
 }
 
-/// "X,Y,Z" in metres.
-pub fn parse_at(s: &str) -> Result<Vec3, String> {
-    let v: Vec<f32> = s
-        .split(',')
-        .map(|x| x.trim().parse::<f32>())
-        .collect::<Result<_, _>>()
-        .map_err(|e| format!("--at {s:?}: {e}"))?;
-    match v.as_slice() {
-        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(Vec3::new(*x, *y, *z)),
-        _ => Err(format!("--at {s:?}: three finite numbers X,Y,Z")),
-    }
-}
-
 pub fn run(args: &CompositeArgs) -> Result<(), String> {
     let say = |s: &str| {
         if !args.json {
@@ -98,7 +85,7 @@ pub fn run(args: &CompositeArgs) -> Result<(), String> {
         }
     };
     let e = |e: differential_composite::CompositeError| e.to_string();
-    let at = parse_at(&args.at)?;
+    let at = crate::common::parse_vec3(&args.at).map_err(|e| format!("--at {e}"))?;
     let patch_maps = match args.patch_maps.as_str() {
         "paraboloid" => shadowmap_paraboloid::Technique::DualParaboloid,
         "cube" => shadowmap_paraboloid::Technique::Cube,

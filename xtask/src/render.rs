@@ -14,9 +14,24 @@ use std::time::Duration;
 /// What `render` was asked for (parsed by clap).
 #[derive(clap::Args)]
 pub struct RenderArgs {
-    /// Built-in scene.
+    /// Built-in scene, or a glTF 2.0 model (`.gltf`, `.glb`).
     #[arg(long)]
     pub scene: String,
+    /// For a model: a Lambertian ground plane under it (albedo 0.5, or the value given).
+    #[arg(long, num_args = 0..=1, default_missing_value = "0.5")]
+    pub ground: Option<f32>,
+    /// For a model: its N-th camera (0-based) instead of the first perspective one.
+    #[arg(long)]
+    pub camera_index: Option<usize>,
+    /// Camera position X,Y,Z (with --target), overriding the scene's camera.
+    #[arg(long, value_parser = crate::common::parse_vec3, requires = "target")]
+    pub eye: Option<glam::Vec3>,
+    /// Point looked at X,Y,Z (with --eye).
+    #[arg(long, value_parser = crate::common::parse_vec3, requires = "eye")]
+    pub target: Option<glam::Vec3>,
+    /// Horizontal field of view in degrees (+Y up), overriding the scene's camera.
+    #[arg(long)]
+    pub fov: Option<f32>,
     /// Environment map; the embedded default when absent.
     #[arg(long)]
     pub envmap: Option<PathBuf>,
@@ -90,13 +105,39 @@ pub fn load_lights(path: &Path) -> Result<LightsData, String> {
 }
 
 pub fn run(args: &RenderArgs) -> Result<(), String> {
-    let mut scene = Scene::builtin(&args.scene).map_err(|e| e.to_string())?;
+    if let Some((w, h)) = args.size
+        && (w == 0 || h == 0 || u64::from(w) * u64::from(h) > 1 << 26)
+    {
+        return Err(format!("--size {w}x{h}: each side at least 1 and at most 2^26 pixels in all"));
+    }
+    if args.ground.is_some_and(|a| !(0.0..=1.0).contains(&a)) {
+        return Err("--ground: an albedo in [0, 1]".into());
+    }
+    if args.fov.is_some_and(|f| !(f > 0.0 && f < 180.0)) {
+        return Err("--fov: degrees in (0, 180)".into());
+    }
+    let options = scene::import::GltfOptions {
+        size: args.size.unwrap_or((640, 480)),
+        camera_index: args.camera_index,
+        ground: args.ground,
+        ..scene::import::GltfOptions::default()
+    };
+    let (mut scene, warnings) = Scene::open(&args.scene, &options).map_err(|e| e.to_string())?;
+    for w in warnings {
+        eprintln!("warning: {}: {w}", args.scene);
+    }
     if let Some((w, h)) = args.size {
-        if w == 0 || h == 0 || u64::from(w) * u64::from(h) > 1 << 26 {
-            return Err(format!("--size {w}x{h}: each side at least 1 and at most 2^26 pixels in all"));
-        }
         scene.camera.width = w;
         scene.camera.height = h;
+    }
+    if let (Some(eye), Some(target)) = (args.eye, args.target) {
+        if (target - eye).length_squared() == 0.0 {
+            return Err("--eye and --target: two different points".into());
+        }
+        (scene.camera.eye, scene.camera.target, scene.camera.up) = (eye, target, glam::Vec3::Y);
+    }
+    if let Some(fov) = args.fov {
+        scene.camera.hfov_degrees = fov;
     }
     if args.spp == 0 {
         return Err("--spp must be at least 1".into());

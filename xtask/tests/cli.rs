@@ -653,3 +653,71 @@ fn trade_writes_its_three_files_and_merges_them_back() {
     assert_eq!(o.status.code(), Some(2), "clap refuses a bad shard");
     assert!(String::from_utf8_lossy(&o.stderr).contains("I/N"));
 }
+
+/// A unit cube [0, 1]³ as `cube.gltf` + `cube.bin` in `dir`.
+fn write_cube_gltf(dir: &Path) -> PathBuf {
+    let mut bin: Vec<u8> = (0..8)
+        .flat_map(|i| [(i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32])
+        .flat_map(f32::to_le_bytes)
+        .collect();
+    let faces: [[u16; 4]; 6] = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    bin.extend(faces.iter().flat_map(|f| [f[0], f[1], f[2], f[0], f[2], f[3]]).flat_map(u16::to_le_bytes));
+    std::fs::write(dir.join("cube.bin"), &bin).expect("write bin");
+    let json = r#"{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+      "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+      "buffers": [{"uri": "cube.bin", "byteLength": 168}],
+      "bufferViews": [{"buffer": 0, "byteLength": 96}, {"buffer": 0, "byteOffset": 96, "byteLength": 72}],
+      "accessors": [{"bufferView": 0, "componentType": 5126, "count": 8, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 1]},
+                    {"bufferView": 1, "componentType": 5123, "count": 36, "type": "SCALAR"}]}"#;
+    let path = dir.join("cube.gltf");
+    std::fs::write(&path, json).expect("write gltf");
+    path
+}
+
+#[test]
+fn render_takes_a_gltf_model_with_a_ground_and_a_camera_of_ones_own() {
+    let dir = fresh_dir("cli-render-gltf");
+    let cube = write_cube_gltf(&dir);
+    let out_path = dir.join("cube.exr");
+    let args = [
+        "render",
+        "--scene",
+        cube.to_str().unwrap_or_default(),
+        "--ground",
+        "--size",
+        "64x32",
+        "--spp",
+        "2",
+        "--eye",
+        "0.5,0.5,5",
+        "--target",
+        "0.5,0.5,0",
+        "--fov",
+        "30",
+        "--aovs",
+        "--out",
+        out_path.to_str().unwrap_or_default(),
+    ];
+    let out = xtask(&args);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    // the centre pixel's ray meets the cube's front face z = 1 at distance 4
+    let depth = envmap_sphere::EnvMap::load(dir.join("cube.depth.exr")).expect("depth");
+    let centre = depth.pixel(32, 16).x;
+    assert!((centre - 4.0).abs() < 0.05, "depth at the centre {centre}");
+    // the ground lies at the cube's lowest point, y = 0: the bottom row sees it, nearer than the sky
+    let bottom = depth.pixel(32, 31).x;
+    assert!(bottom > 0.0, "the bottom row misses the ground");
+    // a model that is not glTF: one line naming the file, exit 1
+    let html = dir.join("page.glb");
+    std::fs::write(&html, "<html>404</html>").expect("write");
+    let out = xtask(&[
+        "render",
+        "--scene",
+        html.to_str().unwrap_or_default(),
+        "--out",
+        out_path.to_str().unwrap_or_default(),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.trim().lines().count() == 1 && err.contains("page.glb"), "{err}");
+}

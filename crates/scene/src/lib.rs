@@ -12,6 +12,7 @@
 pub mod brdf;
 mod builtin;
 mod camera;
+pub mod import;
 mod light;
 mod material;
 mod mesh;
@@ -58,6 +59,9 @@ pub enum SceneError {
         /// The name asked for.
         name: String,
     },
+    /// A model file that could not be imported.
+    #[error(transparent)]
+    Gltf(#[from] import::GltfError),
     /// Writing a file failed.
     #[error("{path}: {source}")]
     Io {
@@ -69,6 +73,21 @@ pub enum SceneError {
 }
 
 impl Scene {
+    /// A built-in scene by name, or a glTF model by path (`.gltf`, `.glb`, or any existing file)
+    /// imported with `options`; the import's warnings come back with it (none for a built-in).
+    ///
+    /// # Errors
+    /// An unknown name; a model that cannot be imported.
+    pub fn open(spec: &str, options: &import::GltfOptions) -> Result<(Self, Vec<String>), SceneError> {
+        let path = std::path::Path::new(spec);
+        let model = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"));
+        if model || (!BUILTIN_SCENES.contains(&spec) && path.is_file()) {
+            let import = import::load_gltf(path, options)?;
+            return Ok((import.scene, import.warnings));
+        }
+        Ok((Self::builtin(spec)?, Vec::new()))
+    }
+
     /// Total number of triangles.
     #[must_use]
     pub fn triangle_count(&self) -> usize {
