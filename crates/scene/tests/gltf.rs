@@ -16,7 +16,7 @@ fn dir(name: &str) -> PathBuf {
 fn bin(positions: &[Vec3], indices: &[u16]) -> Vec<u8> {
     let mut b: Vec<u8> = positions.iter().flat_map(|p| p.to_array()).flat_map(f32::to_le_bytes).collect();
     b.extend(indices.iter().flat_map(|i| i.to_le_bytes()));
-    while b.len() % 4 != 0 {
+    while !b.len().is_multiple_of(4) {
         b.push(0);
     }
     b
@@ -70,7 +70,7 @@ fn write_gltf(d: &Path, name: &str, json: &str, bin: &[u8]) -> PathBuf {
 /// A GLB of `json` and `bin`.
 fn glb(json: &str, bin: &[u8]) -> Vec<u8> {
     let mut j = json.as_bytes().to_vec();
-    while j.len() % 4 != 0 {
+    while !j.len().is_multiple_of(4) {
         j.push(b' ');
     }
     let total = 12 + 8 + j.len() + 8 + bin.len();
