@@ -100,7 +100,7 @@ fn run(args: &EvalLightsArgs) -> Result<(), String> {
         .collect::<Result<Vec<_>, String>>()?;
     let mut rows = Vec::new();
     for map_path in &maps {
-        let map = load_map(Some(map_path))?;
+        let map = load_map(Some(map_path)).map_err(|e| e.to_string())?;
         let map_name = map_path.file_name().map_or_else(String::new, |n| n.to_string_lossy().to_string());
         bar.set_message(map_name.clone());
         let mut progress = |what: &str| {

@@ -40,7 +40,7 @@ pub fn run(args: &FrameArgs) -> Result<(), String> {
     if !args.json {
         outln!("GPU: {}", gpu.describe());
     }
-    let map = crate::common::load_map(args.envmap)?;
+    let map = crate::common::load_map(args.envmap).map_err(|e| e.to_string())?;
     let mut frame = Frame::new(&gpu, args.scene, args.size, &map, args.lights)?;
     let moving = args.animate.then(|| animated_object(&frame.scene));
     let d = &frame.decomposition;

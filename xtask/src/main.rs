@@ -1,9 +1,10 @@
-//! `cargo xtask`: the project's commands. `validate` is the main job, `test` runs the test
-//! suite; the rest are user-facing tools. One module per subcommand.
+//! `cargo xtask`: the project's own jobs. `validate` is the main job, `test` runs the test
+//! suite; the rest measure (trade, frame, soft-shadows, eval-lights, shafts) or fuzz. The user's
+//! tools are the `envshadow` binary's. One module per subcommand.
 
 #![allow(clippy::print_stdout, clippy::print_stderr)]
 
-/// `println!` that ignores a closed stdout (`cargo xtask compare a b | head -1` must not panic).
+/// `println!` that ignores a closed stdout (`cargo xtask validate | head -1` must not panic).
 macro_rules! outln {
     ($($arg:tt)*) => {{
         use std::io::Write as _;
@@ -12,15 +13,10 @@ macro_rules! outln {
 }
 
 mod common;
-mod composite;
 mod eval_lights;
-mod extract;
 mod frame;
 mod fuzz;
-mod info;
 mod lavapipe;
-mod render;
-mod scene;
 mod shafts;
 mod soft_shadows;
 mod test;
@@ -62,50 +58,10 @@ enum Command {
         #[arg(last = true)]
         args: Vec<String>,
     },
-    /// Write a built-in scene's geometry (spheres_box, three_boxes, column, glossy_set, room).
-    Scene {
-        /// The scene's name.
-        name: String,
-        /// Output Wavefront OBJ file: one `o` per object, materials in comments.
-        #[arg(long)]
-        obj: PathBuf,
-    },
-    /// Render a built-in scene with the CPU reference tracer: OUT.exr, a tone-mapped OUT.png,
-    /// and with --aovs OUT.albedo.exr, OUT.normal.exr, OUT.depth.exr, OUT.object.exr.
-    Render(render::RenderArgs),
-    /// Decompose a map into shadow-casting lights + ambient: DIR/lights.json, ambient.exr,
-    /// lights.gltf (KHR_lights_punctual) and overlay.png.
-    Extract {
-        /// The map (.exr or .hdr).
-        path: PathBuf,
-        /// emissive-split, center-surround (stops by Weber's law; K is a cap), median-cut,
-        /// variance-min or importance; append +above-horizon to model only the hemisphere above
-        /// the ground (for scenes standing on an opaque ground), to emissive-split
-        /// +moment-cones (before +above-horizon) for cones matching each cluster's spread, and
-        /// last +residual to make ambient.exr the signed residual, map minus lights.
-        #[arg(long, default_value = "median-cut")]
-        method: String,
-        /// Number of lights K (median cut uses the largest power of two not above K).
-        #[arg(long, default_value_t = 32)]
-        lights: usize,
-        /// Output folder; target/extract/<map>-<method> when absent.
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// glTF intensity per unit of the map's luminance x sr (683 for maps in W/(m^2 sr)).
-        #[arg(long, default_value_t = 1.0)]
-        lux_per_unit: f32,
-    },
     /// Every extraction method against the env-direct truth over maps x scenes: Markdown, CSV
     /// and JSON tables under target/eval-lights (paper 001's Table 1). `--shard I/N` runs a
     /// share of the maps; `eval-lights merge DIR... --out DIR` joins shards.
     EvalLights(eval_lights::EvalLightsArgs),
-    /// RMSE and FLIP of TEST against REF (two lines).
-    Compare {
-        /// Reference image (.exr or .hdr).
-        reference: PathBuf,
-        /// Test image of the same size.
-        test: PathBuf,
-    },
     /// Structured fuzzing of every file a command reads (.hdr, .exr, lights.json,
     /// thresholds): mutations of small valid files; prints the findings and last
     /// `fuzz: N cases, P panics, ...`; exits 1 when anything was found.
@@ -202,25 +158,11 @@ enum Command {
         #[arg(long)]
         sweep: bool,
     },
-    /// A synthetic object composited into a built-in real scene's photograph on the GPU
-    /// (paper 003): shadow maps per representative source, transfers subtracted in HDR or, with
-    /// --ldr, intensity transfers in 8-bit codes. Writes OUT (and OUT_photo, _truth, _debevec,
-    /// _error beside it) and prints the error in codes against the path-traced truth and
-    /// Debevec's offline differential rendering, and the time per frame.
-    Composite(composite::CompositeArgs),
     /// The speed/accuracy trade: every setting of a preset (extraction, K, shadow technique and
     /// its knobs, paper 001's split) on scenes x maps, its GPU time per frame and its error
     /// against the env-direct truth; OUT/trade.csv, trade.json and report.html (plots, Pareto
     /// fronts, the chooser's picks). `trade merge DIR... --out DIR` joins shards.
     Trade(trade::TradeArgs),
-    /// Print an environment map's size, format, luminance, power and SH9 coefficients.
-    Info {
-        /// The map (.exr or .hdr).
-        path: PathBuf,
-        /// One JSON object instead of text.
-        #[arg(long)]
-        json: bool,
-    },
 }
 
 /// Set, the command line is parsed (clap's checks: subcommand, options, values) and nothing is
@@ -237,7 +179,6 @@ fn main() -> ExitCode {
         Command::Fuzz { cases, seed } => return fuzz::run(cases, seed),
         Command::Validate(args) => validate::run(&args),
         Command::Test { adapter, args } => test::run(adapter.as_deref(), &args),
-        Command::Info { path, json } => info::run(&path, json),
         Command::Shafts { scene, json, source_share, leaf_size, prune, out, sweep, photo } => {
             let hierarchy = shaft_hierarchy::Settings { leaf_size, prune_fraction: prune, distant_reach: None };
             let settings = shaft_hierarchy::preprocess::PreprocessSettings {
@@ -247,7 +188,6 @@ fn main() -> ExitCode {
             };
             shafts::run(&shafts::ShaftsArgs { scene: &scene, json, settings, sweep, photo, out: &out })
         }
-        Command::Composite(args) => composite::run(&args),
         Command::Trade(args) => trade::run(&args),
         Command::SoftShadows { scenes, size, adapter, out } => {
             soft_shadows::run(&scenes, size, adapter.as_deref(), &out)
@@ -265,13 +205,7 @@ fn main() -> ExitCode {
                 scale,
             })
         }
-        Command::Scene { name, obj } => scene::run(&name, &obj),
-        Command::Render(args) => render::run(&args),
-        Command::Compare { reference, test } => render::compare(&reference, &test),
         Command::EvalLights(args) => eval_lights::command(&args),
-        Command::Extract { path, method, lights, out, lux_per_unit } => {
-            extract::run(&path, &method, lights, out.as_deref(), lux_per_unit)
-        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -21,71 +21,18 @@ fn shared(name: &str) -> PathBuf {
 }
 
 #[test]
-fn info_json_has_the_documented_keys_and_values() {
-    let path = shared("city.exr");
-    let out = xtask(&["info", path.to_str().unwrap_or_default(), "--json"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let text = String::from_utf8_lossy(&out.stdout);
-    assert_eq!(text.trim().lines().count(), 1, "one JSON object on one line: {text}");
-    let v: serde_json::Value = serde_json::from_str(&text).expect("valid JSON");
-    let keys: Vec<&str> = v.as_object().expect("an object").keys().map(String::as_str).collect();
-    for k in [
-        "width",
-        "height",
-        "format",
-        "compression",
-        "converted_from_primaries",
-        "max_luminance",
-        "mean_luminance",
-        "power",
-        "sh9",
-    ] {
-        assert!(keys.contains(&k), "missing key {k} in {keys:?}");
-    }
-    assert_eq!((v["width"].as_u64(), v["height"].as_u64()), (Some(1024), Some(512)));
-    assert_eq!((v["format"].as_str(), v["compression"].as_str()), (Some("exr"), Some("dwab")));
-    // city.exr declares sRGB primaries adapted to D50 (white at x 0.3457): read converted to
-    // Rec.709 of the same XYZ, its maximum luminance moves (stored values: 31749.4)
-    let white = &v["converted_from_primaries"][3];
-    assert!((white[0].as_f64().unwrap_or(0.0) - 0.3457).abs() < 1e-4, "{white}");
-    let (max, mean) = (v["max_luminance"].as_f64().unwrap_or(0.0), v["mean_luminance"].as_f64().unwrap_or(0.0));
-    assert!((max - 31839.6).abs() < 1.0, "{max}");
-    assert!((mean - 1.055).abs() < 0.01, "{mean}"); // XYZ is kept, so luminance barely moves
-    let power = v["power"].as_array().expect("power array");
-    assert_eq!(power.len(), 3);
-    let sh9 = v["sh9"].as_array().expect("sh9 array");
-    assert!(sh9.len() == 9 && sh9.iter().all(|c| c.as_array().is_some_and(|c| c.len() == 3)));
-    // sh9[0] = integral of L * Y00 = power * 0.2820948
-    let p0 = power[0].as_f64().unwrap_or(0.0);
-    let c0 = sh9[0][0].as_f64().unwrap_or(0.0);
-    assert!((c0 / (p0 * 0.282_094_8) - 1.0).abs() < 1e-4, "{c0} vs {p0}");
-}
-
-#[test]
-fn info_text_lists_the_statistics() {
-    let path = shared("venice_sunset_1k.hdr");
-    let out = xtask(&["info", path.to_str().unwrap_or_default()]);
-    assert!(out.status.success());
-    let text = String::from_utf8_lossy(&out.stdout);
-    for needle in ["1024 x 512", "hdr (rle)", "max 2090.", "power", "sh9 l2 m2"] {
-        assert!(text.contains(needle), "missing {needle:?} in:\n{text}");
-    }
-}
-
-#[test]
 fn bad_input_exits_one_with_one_line_naming_the_file() {
     let dir = fresh_dir("cli-bad");
     let text = dir.join("text.hdr");
     std::fs::write(&text, "hello").expect("write");
     for path in [dir.join("missing.exr"), text] {
         let p = path.to_str().unwrap_or_default();
-        for args in [vec!["info", p], vec!["info", p, "--json"], vec!["validate", "--envmap", p]] {
+        for args in [vec!["validate", "--envmap", p], vec!["frame", "--envmap", p]] {
             let out = xtask(&args);
             assert_eq!(out.status.code(), Some(1), "{args:?}");
             let err = String::from_utf8_lossy(&out.stderr);
             assert_eq!(err.trim().lines().count(), 1, "{args:?}: {err}");
             assert!(err.contains(p), "{args:?}: {err}");
-            assert!(out.stdout.is_empty() || args[0] == "validate", "{args:?}");
         }
     }
 }
@@ -252,173 +199,6 @@ fn frame_times_each_resolution_and_refuses_bad_arguments_in_one_line() {
 }
 
 #[test]
-fn scene_writes_obj_and_refuses_unknown_names() {
-    let dir = fresh_dir("cli-scene");
-    let obj = dir.join("spheres_box.obj");
-    let out = xtask(&["scene", "spheres_box", "--obj", obj.to_str().unwrap_or_default()]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    assert!(String::from_utf8_lossy(&out.stdout).contains("20494 triangles"));
-    let text = std::fs::read_to_string(&obj).expect("OBJ written");
-    assert_eq!(text.lines().filter(|l| l.starts_with("o ")).count(), 3);
-    assert_eq!(text.lines().filter(|l| l.starts_with("f ")).count(), 20_494);
-    let out = xtask(&["scene", "teapot", "--obj", obj.to_str().unwrap_or_default()]);
-    assert_eq!(out.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("unknown scene \"teapot\""));
-}
-
-#[test]
-fn render_writes_images_and_compare_reports_rmse_and_flip() {
-    let dir = fresh_dir("cli-render");
-    let (a, b) = (dir.join("a.exr"), dir.join("b.exr"));
-    let base = ["render", "--scene", "spheres_box", "--size", "64x48", "--spp", "4"];
-    let out = xtask(&[&base[..], &["--seed", "1", "--aovs", "--out", a.to_str().unwrap_or_default()]].concat());
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let line = String::from_utf8_lossy(&out.stdout);
-    assert_eq!(line.trim().lines().count(), 1, "one summary line: {line}");
-    assert!(line.contains("64 x 48, 4 spp") && line.contains("samples/s"), "{line}");
-    for f in ["a.exr", "a.png", "a.albedo.exr", "a.normal.exr", "a.depth.exr", "a.object.exr"] {
-        assert!(dir.join(f).exists(), "{f} missing");
-    }
-    let out = xtask(
-        &[&base[..], &["--seed", "2", "--env-sampling", "complete", "--out", b.to_str().unwrap_or_default()]].concat(),
-    );
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let out = xtask(&[&base[..], &["--env-sampling", "some", "--out", b.to_str().unwrap_or_default()]].concat());
-    assert_eq!(out.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&out.stderr).trim().lines().count() == 1);
-    let out = xtask(&["compare", a.to_str().unwrap_or_default(), b.to_str().unwrap_or_default()]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let text = String::from_utf8_lossy(&out.stdout);
-    let lines: Vec<&str> = text.trim().lines().collect();
-    assert_eq!(lines.len(), 2, "{text}");
-    let value = |line: &str, key: &str| -> f64 {
-        assert!(line.starts_with(key), "{line}");
-        line.split_whitespace().nth(1).and_then(|v| v.parse().ok()).unwrap_or(-1.0)
-    };
-    assert!(value(lines[0], "RMSE") > 0.0);
-    assert!(value(lines[1], "FLIP") > 0.0 && lines[1].contains("ACES"), "the tone mapping is stated");
-    // identical images: zero
-    let out = xtask(&["compare", a.to_str().unwrap_or_default(), a.to_str().unwrap_or_default()]);
-    assert!(String::from_utf8_lossy(&out.stdout).starts_with("RMSE 0.000000\nFLIP 0.000000"));
-    // mismatched sizes and bad files: exit 1, one line
-    let c = dir.join("c.exr");
-    let out = xtask(&[
-        "render",
-        "--scene",
-        "column",
-        "--size",
-        "32x24",
-        "--spp",
-        "1",
-        "--out",
-        c.to_str().unwrap_or_default(),
-    ]);
-    assert!(out.status.success());
-    for (x, y) in [(&a, &c), (&a, &dir.join("missing.exr"))] {
-        let out = xtask(&["compare", x.to_str().unwrap_or_default(), y.to_str().unwrap_or_default()]);
-        assert_eq!(out.status.code(), Some(1));
-        assert_eq!(String::from_utf8_lossy(&out.stderr).trim().lines().count(), 1);
-    }
-}
-
-#[test]
-fn render_with_lights_reads_the_light_extract_schema() {
-    let dir = fresh_dir("cli-lights");
-    let json = dir.join("lights.json");
-    std::fs::write(
-        &json,
-        r#"{"method": "hand", "lights": [{"direction": [0.3, 0.8, 0.5], "solid_angle": 0.001, "radiance": [2000, 1900, 1800], "power": [2, 1.9, 1.8], "extent": 0.02}]}"#,
-    )
-    .expect("write json");
-    let out_path = dir.join("l.exr");
-    let args = ["render", "--scene", "spheres_box", "--size", "32x24", "--spp", "2", "--integrator", "lights"];
-    let out = xtask(
-        &[&args[..], &["--lights", json.to_str().unwrap_or_default(), "--out", out_path.to_str().unwrap_or_default()]]
-            .concat(),
-    );
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let img = envmap_sphere::EnvMap::load(&out_path).expect("the render is written");
-    assert!(img.pixels().iter().any(|p| p.max_element() > 0.0), "the light lit the scene");
-    std::fs::remove_file(&out_path).expect("remove");
-    std::fs::write(&json, r#"{"lights": [{"direction": [0, 0, 0], "solid_angle": 0.1, "radiance": [1, 1, 1]}]}"#)
-        .expect("write");
-    let out = xtask(
-        &[&args[..], &["--lights", json.to_str().unwrap_or_default(), "--out", out_path.to_str().unwrap_or_default()]]
-            .concat(),
-    );
-    assert_eq!(out.status.code(), Some(1));
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("lights.json") && err.contains("light 0"), "{err}");
-    assert!(!out_path.exists(), "nothing written after an error");
-}
-
-#[test]
-fn extract_writes_the_four_files_and_a_line_per_light() {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli-extract");
-    let _ = std::fs::remove_dir_all(&dir);
-    let map = shared("venice_sunset_1k.hdr");
-    let out = xtask(&[
-        "extract",
-        map.to_str().unwrap_or_default(),
-        "--lights",
-        "16",
-        "--out",
-        dir.to_str().unwrap_or_default(),
-    ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let text = String::from_utf8_lossy(&out.stdout);
-    assert_eq!(text.lines().filter(|l| l.starts_with("light ")).count(), 16, "{text}");
-    assert!(text.contains("median-cut: 16 lights in") && text.contains("light power / map power = 1.0000"), "{text}");
-    for f in ["lights.json", "ambient.exr", "lights.gltf", "overlay.png"] {
-        assert!(dir.join(f).exists(), "{f} missing");
-    }
-    // the lights feed the reference tracer's lights integrator
-    let img = dir.join("r.exr");
-    let render = |scene: &str, json: &Path| {
-        let out = xtask(&[
-            "render",
-            "--scene",
-            scene,
-            "--size",
-            "32x24",
-            "--spp",
-            "2",
-            "--integrator",
-            "lights",
-            "--lights",
-            json.to_str().unwrap_or_default(),
-            "--out",
-            img.to_str().unwrap_or_default(),
-        ]);
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    };
-    render("spheres_box", &dir.join("lights.json"));
-    // +residual: a signed ambient.exr, which render reads with its signs
-    let residual = dir.join("residual");
-    let out = xtask(&[
-        "extract",
-        map.to_str().unwrap_or_default(),
-        "--method",
-        "median-cut+above-horizon+residual",
-        "--lights",
-        "16",
-        "--out",
-        residual.to_str().unwrap_or_default(),
-    ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let keep = envmap_sphere::LoadOptions { negative: envmap_sphere::NegativePolicy::Keep, ..Default::default() };
-    let (ambient, _) = envmap_sphere::EnvMap::load_with(residual.join("ambient.exr"), &keep).expect("ambient.exr");
-    assert!(ambient.pixels().iter().any(|p| p.min_element() < 0.0), "the residual is signed");
-    render("glossy_set", &residual.join("lights.json"));
-    let out = xtask(&["extract", map.to_str().unwrap_or_default(), "--method", "nope"]);
-    assert_eq!(out.status.code(), Some(1));
-    assert!(
-        String::from_utf8_lossy(&out.stderr)
-            .contains("emissive-split, center-surround, median-cut, variance-min, importance")
-    );
-}
-
-#[test]
 fn eval_lights_writes_both_tables_with_a_noise_floor() {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli-eval");
     let maps = dir.join("maps");
@@ -517,35 +297,6 @@ fn shafts_json_has_the_interface_keys_and_misses_nothing() {
     let bad = xtask(&["shafts", "--scene", "nope"]);
     assert_eq!(bad.status.code(), Some(1));
     assert_eq!(String::from_utf8_lossy(&bad.stderr).trim().lines().count(), 1);
-}
-
-#[test]
-fn composite_json_has_the_interface_keys_and_writes_the_images() {
-    let dir = fresh_dir("cli-composite");
-    let out = dir.join("c.png");
-    let args = ["composite", "--scene", "ar_ground", "--object", "sphere", "--at", "0,0.3,1", "--passes", "10"];
-    let size = ["--size", "64x48", "--spp", "8"];
-    let run = xtask(&[&args[..], &size, &["--out", out.to_str().unwrap_or_default(), "--json"]].concat());
-    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
-    let text = String::from_utf8_lossy(&run.stdout);
-    assert_eq!(text.trim().lines().count(), 1, "one JSON object on one line: {text}");
-    let v: serde_json::Value = serde_json::from_str(&text).expect("valid JSON");
-    for k in ["passes", "ms_per_frame", "error_mae_codes", "debevec_error_mae_codes", "error_rmse_codes"] {
-        assert!(v.get(k).is_some_and(serde_json::Value::is_number), "missing number {k} in {v}");
-    }
-    assert!(v["adapter"].as_str().is_some_and(|a| !a.is_empty()), "{v}");
-    assert_eq!(v["passes"].as_u64(), Some(10));
-    assert!(v["ms_per_frame"].as_f64().unwrap_or(0.0) > 0.0);
-    for f in ["c.png", "c_photo.png", "c_truth.png", "c_debevec.png", "c_error.png"] {
-        assert!(dir.join(f).is_file(), "{f} missing");
-    }
-    // bad input: one line naming what is wrong, exit 1
-    for (bad, want) in [(["--object", "teapot"], "teapot"), (["--at", "1,2"], "--at")] {
-        let run = xtask(&[&["composite", "--scene", "ar_ground", "--size", "16x12", "--spp", "1"][..], &bad].concat());
-        assert_eq!(run.status.code(), Some(1), "{bad:?}");
-        let err = String::from_utf8_lossy(&run.stderr);
-        assert!(err.trim().lines().count() == 1 && err.contains(want), "{err}");
-    }
 }
 
 /// The CSV without its timing column (extraction ms is measured anew in every run).
@@ -652,72 +403,4 @@ fn trade_writes_its_three_files_and_merges_them_back() {
     let o = xtask(&["trade", "--quick", "--shard", "2/2", "--out", dir.to_str().unwrap_or_default()]);
     assert_eq!(o.status.code(), Some(2), "clap refuses a bad shard");
     assert!(String::from_utf8_lossy(&o.stderr).contains("I/N"));
-}
-
-/// A unit cube [0, 1]³ as `cube.gltf` + `cube.bin` in `dir`.
-fn write_cube_gltf(dir: &Path) -> PathBuf {
-    let mut bin: Vec<u8> = (0..8)
-        .flat_map(|i| [(i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32])
-        .flat_map(f32::to_le_bytes)
-        .collect();
-    let faces: [[u16; 4]; 6] = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
-    bin.extend(faces.iter().flat_map(|f| [f[0], f[1], f[2], f[0], f[2], f[3]]).flat_map(u16::to_le_bytes));
-    std::fs::write(dir.join("cube.bin"), &bin).expect("write bin");
-    let json = r#"{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
-      "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
-      "buffers": [{"uri": "cube.bin", "byteLength": 168}],
-      "bufferViews": [{"buffer": 0, "byteLength": 96}, {"buffer": 0, "byteOffset": 96, "byteLength": 72}],
-      "accessors": [{"bufferView": 0, "componentType": 5126, "count": 8, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 1]},
-                    {"bufferView": 1, "componentType": 5123, "count": 36, "type": "SCALAR"}]}"#;
-    let path = dir.join("cube.gltf");
-    std::fs::write(&path, json).expect("write gltf");
-    path
-}
-
-#[test]
-fn render_takes_a_gltf_model_with_a_ground_and_a_camera_of_ones_own() {
-    let dir = fresh_dir("cli-render-gltf");
-    let cube = write_cube_gltf(&dir);
-    let out_path = dir.join("cube.exr");
-    let args = [
-        "render",
-        "--scene",
-        cube.to_str().unwrap_or_default(),
-        "--ground",
-        "--size",
-        "64x32",
-        "--spp",
-        "2",
-        "--eye",
-        "0.5,0.5,5",
-        "--target",
-        "0.5,0.5,0",
-        "--fov",
-        "30",
-        "--aovs",
-        "--out",
-        out_path.to_str().unwrap_or_default(),
-    ];
-    let out = xtask(&args);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    // the centre pixel's ray meets the cube's front face z = 1 at distance 4
-    let depth = envmap_sphere::EnvMap::load(dir.join("cube.depth.exr")).expect("depth");
-    let centre = depth.pixel(32, 16).x;
-    assert!((centre - 4.0).abs() < 0.05, "depth at the centre {centre}");
-    // the ground lies at the cube's lowest point, y = 0: the bottom row sees it, nearer than the sky
-    let bottom = depth.pixel(32, 31).x;
-    assert!(bottom > 0.0, "the bottom row misses the ground");
-    // a model that is not glTF: one line naming the file, exit 1
-    let html = dir.join("page.glb");
-    std::fs::write(&html, "<html>404</html>").expect("write");
-    let out = xtask(&[
-        "render",
-        "--scene",
-        html.to_str().unwrap_or_default(),
-        "--out",
-        out_path.to_str().unwrap_or_default(),
-    ]);
-    assert_eq!(out.status.code(), Some(1));
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.trim().lines().count() == 1 && err.contains("page.glb"), "{err}");
 }

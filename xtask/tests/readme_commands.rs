@@ -1,6 +1,7 @@
-//! Every command line the README and docs show runs as written: `cargo xtask` lines parse
-//! (the binary with `XTASK_PARSE_ONLY` set: clap's checks, nothing run) and the repository files
-//! they name exist; `cargo bench` lines name a bench target of the package cargo would pick;
+//! Every command line the README and docs show runs as written: `cargo xtask` lines and the
+//! user tool's (`cargo run --release -p envshadow -- …`, or `envshadow …` once installed) parse
+//! (the binary with `XTASK_PARSE_ONLY` / `ENVSHADOW_PARSE_ONLY` set: clap's checks, nothing run)
+//! and the repository files they name exist; `cargo bench` lines name a bench target of the package cargo would pick;
 //! other cargo lines are the ones CI runs; `tools/` scripts exist and take the options shown.
 
 use std::path::{Path, PathBuf};
@@ -24,6 +25,7 @@ fn commands() -> Vec<(String, usize, String)> {
     docs.extend(more);
     let is_command = |s: &str| {
         s.starts_with("cargo ")
+            || s.starts_with("envshadow ")
             || (s.starts_with("tools/")
                 && s.split_whitespace().next().is_some_and(|w| w.ends_with(".sh") || w.ends_with(".py")))
     };
@@ -75,13 +77,28 @@ fn is_synopsis(args: &[&str]) -> bool {
 
 /// Why `cargo xtask ARGS` would not run as written, if it would not.
 fn xtask_problem(args: &[&str]) -> Option<String> {
+    cli_problem(Path::new(env!("CARGO_BIN_EXE_xtask")), "XTASK_PARSE_ONLY", args)
+}
+
+/// The user tool's binary: built beside xtask's by `cargo test --workspace` (a test cannot
+/// depend on another package's binary).
+fn envshadow_binary() -> PathBuf {
+    let bin =
+        Path::new(env!("CARGO_BIN_EXE_xtask")).with_file_name(format!("envshadow{}", std::env::consts::EXE_SUFFIX));
+    assert!(bin.is_file(), "{} is not built: run the tests with `cargo test --workspace`", bin.display());
+    bin
+}
+
+/// Why `envshadow ARGS` would not run as written, if it would not.
+fn envshadow_problem(args: &[&str]) -> Option<String> {
+    cli_problem(&envshadow_binary(), "ENVSHADOW_PARSE_ONLY", args)
+}
+
+/// Why `BIN ARGS` would not run as written, if it would not (`parse_only`: the variable that
+/// makes the binary parse and stop).
+fn cli_problem(bin: &Path, parse_only: &str, args: &[&str]) -> Option<String> {
     let run = |args: &[&str]| {
-        Command::new(env!("CARGO_BIN_EXE_xtask"))
-            .args(args)
-            .env("XTASK_PARSE_ONLY", "1")
-            .current_dir(root())
-            .output()
-            .expect("run xtask")
+        Command::new(bin).args(args).env(parse_only, "1").current_dir(root()).output().expect("run the binary")
     };
     let first_error =
         |o: &std::process::Output| String::from_utf8_lossy(&o.stderr).lines().next().unwrap_or_default().to_string();
@@ -178,6 +195,12 @@ fn every_command_in_the_readme_and_docs_runs_as_written() {
             // a mention of the alias itself, not a command line
             ["cargo", "xtask"] => None,
             ["cargo", "xtask", args @ ..] => xtask_problem(args),
+            ["cargo", "run", "--release", "-p", "envshadow", "--", args @ ..] | ["envshadow", args @ ..] => {
+                envshadow_problem(args)
+            }
+            ["cargo", "install", "--path", path] => {
+                (!root().join(path).join("Cargo.toml").is_file()).then(|| format!("no crate at {path}"))
+            }
             ["cargo", "bench", args @ ..] => bench_problem(args, &benches, &defaults),
             // an example: its crate's file
             ["cargo", "run", "--release", "-p", krate, "--example", name, ..] => example_problem(krate, name),
@@ -211,6 +234,11 @@ fn the_checks_find_what_would_fail() {
     assert!(xtask_problem(&["shafts", "[--nope]"]).is_some(), "an option the synopsis invents");
     assert!(xtask_problem(&["nope"]).is_some(), "an unknown subcommand");
     assert!(xtask_problem(&["shafts", "[--scene", "ar_room|ar_ground]", "[--json]"]).is_none());
+    assert!(envshadow_problem(&["render", "--nope"]).is_some(), "an option render does not have");
+    assert!(envshadow_problem(&["validate"]).is_some(), "a job of xtask's, not the user tool's");
+    assert!(xtask_problem(&["render", "--scene", "room"]).is_some(), "a user command, not one of xtask's jobs");
+    assert!(envshadow_problem(&["info", "assets/envmaps/nowhere.exr"]).is_some(), "a missing file");
+    assert!(envshadow_problem(&["render", "[--ground]", "[--aovs]"]).is_none());
     let (benches, defaults) = workspace();
     assert!(bench_problem(&["--bench", "no_such_bench"], &benches, &defaults).is_some());
     assert!(bench_problem(&["-p", "envshadow-benches", "--bench", "shafts"], &benches, &defaults).is_none());

@@ -17,7 +17,7 @@ use real_scene::RealScene;
 use ref_tracer::metrics::flip_rgb8;
 
 /// Where the sphere sits, from the scene's floor centre: `ar_ground`'s in front of the boxes
-/// (`validate`'s), elsewhere 0.5 m forward (`cargo xtask composite`'s default).
+/// (`validate`'s), elsewhere 0.5 m forward (`envshadow composite`'s default).
 #[must_use]
 pub fn object_position(scene: &str) -> Vec3 {
     if scene == "ar_ground" { Vec3::new(0.0, 0.3, 1.0) } else { Vec3::new(0.0, 0.3, 0.5) }

@@ -18,6 +18,7 @@
 //! never share a front or a choice (their errors are against different truths). Library code:
 //! no printing, progress goes to a callback.
 
+pub mod args;
 pub mod banding;
 pub mod capture;
 pub mod composite;

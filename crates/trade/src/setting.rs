@@ -230,7 +230,7 @@ impl Setting {
 /// The knobs of an environment-lit frame.
 #[derive(Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct EnvSetting {
-    /// The extraction, as `cargo xtask extract --method` (options included); `+residual` makes
+    /// The extraction, as `envshadow extract --method` (options included); `+residual` makes
     /// the ambient the signed residual, else it is the method's SH9 remainder.
     pub method: String,
     /// Lights K.

@@ -28,10 +28,15 @@ pub struct ValidateArgs {
     /// Environment map (.exr or .hdr); the embedded default map when absent.
     #[arg(long)]
     pub envmap: Option<PathBuf>,
-    /// Built-in scene lit by the map.
+    /// Built-in scene lit by the map, or a glTF 2.0 model (`.gltf`, `.glb`). A model has no
+    /// checked-in thresholds: the best GPU row must be within 1.3x of the ray-traced lights'
+    /// RMSE, the rest is reported.
     #[arg(long, default_value = "spheres_box")]
     pub scene: String,
-    /// Light extraction method (as `cargo xtask extract --method`); the default is the most
+    /// For a model: a Lambertian ground plane under it (albedo 0.5, or the value given).
+    #[arg(long, num_args = 0..=1, default_missing_value = "0.5")]
+    pub ground: Option<f32>,
+    /// Light extraction method (as `envshadow extract --method`); the default is the most
     /// accurate in `eval-lights`. Other methods' threshold keys carry the method.
     #[arg(long, default_value = light_extract::DEFAULT_METHOD)]
     pub method: String,
@@ -197,18 +202,23 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
     let thresholds = load_thresholds(args.thresholds.as_deref())?;
     let mut stages = Stages { total: 10 + usize::from(plan.interleaved), done: 0, start: Instant::now() };
     stages.next("load environment map");
-    let map = load_map(args.envmap.as_deref())?;
+    let map = load_map(args.envmap.as_deref()).map_err(|e| e.to_string())?;
     let map_name = args.envmap.as_ref().map_or_else(
         || envmap_sphere::DEFAULT_MAP_NAME.to_string(),
         |p| p.file_name().map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().to_string()),
     );
-    let mut scene = scene::Scene::builtin(&args.scene).map_err(|e| e.to_string())?;
+    let options = scene::import::GltfOptions { size: plan.size, ground: args.ground, ..Default::default() };
+    let (mut scene, warnings) = scene::Scene::open(&args.scene, &options).map_err(|e| e.to_string())?;
+    let model = !scene::BUILTIN_SCENES.contains(&args.scene.as_str());
+    for w in warnings {
+        outln!("warning: {}: {w}", args.scene);
+    }
     (scene.camera.width, scene.camera.height) = plan.size;
     let (w, h) = plan.size;
 
     stages.next(&format!("extract lights ({})", args.method));
     let extractor = light_extract::extractor(&args.method, plan.lights)
-        .ok_or_else(|| format!("unknown method {} (see cargo xtask extract --help)", args.method))?;
+        .ok_or_else(|| format!("unknown method {} (see envshadow extract --help)", args.method))?;
     let mut decomposition = extractor.extract(&map).map_err(|e| format!("{map_name}: {e}"))?;
     // the EnvDirects first (renderers that split shade the rest at reduced resolution)
     decomposition.sort_directs_first();
@@ -330,7 +340,7 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
     std::fs::create_dir_all(&args.out).map_err(|e| format!("{}: {e}", args.out.display()))?;
     let method =
         if args.method == light_extract::DEFAULT_METHOD { String::new() } else { format!("[{}]", args.method) };
-    let key = format!("{}@{}{method}{}", args.scene, map_name, if args.quick { "/quick" } else { "" });
+    let key = format!("{}@{}{method}{}", scene.name, map_name, if args.quick { "/quick" } else { "" });
     let mut measured: BTreeMap<String, f64> = BTreeMap::new();
     for r in &rows {
         if let (Some(rm), Some(fl)) = (r.rmse, r.flip) {
@@ -348,7 +358,7 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
         gpu: &gpu,
         plan: &plan,
         map_name: &map_name,
-        scene: &args.scene,
+        scene: &scene.name,
         rows: &rows,
         masks: &mask_rows,
         mask_images: &mask_images,
@@ -366,7 +376,7 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
     };
     let path = args.out.join("report.html");
     std::fs::write(&path, report.html(&args.out)?).map_err(|e| format!("{}: {e}", path.display()))?;
-    // every image as linear EXR beside the report, for `cargo xtask compare` and viewers
+    // every image as linear EXR beside the report, for `envshadow compare` and viewers
     for r in &rows {
         let exr = args.out.join(format!("{}.exr", r.name));
         envmap_sphere::io::save_exr_rgb(&exr, w as usize, h as usize, &r.image).map_err(|e| e.to_string())?;
@@ -379,6 +389,15 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
     let rmse_of = |n: &str| rows.iter().find(|r| r.name == n).and_then(|r| r.rmse);
     if let (Some(g), Some(t)) = (rmse_of("gpu_wedges"), rmse_of("lights_ray_traced")) {
         outln!("  gpu_wedges / lights_ray_traced RMSE: {:.2}x (goal 1.2x)", g / t);
+    }
+    let mut failures = failures;
+    if model {
+        // no thresholds for a file: the best real-time row against the same lights ray traced
+        let (line, ok) = best_gpu_line(&rows, MODEL_GOAL)?;
+        outln!("{line}");
+        if !ok {
+            failures.push(line.trim().to_string());
+        }
     }
     if let Some(budget) = args.budget_ms {
         outln!("{}", budget_line(&rows, budget)?);
@@ -404,7 +423,7 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
             "{:?}, {:?}; driver {} {}",
             gpu.info.backend, gpu.info.device_type, gpu.info.driver, gpu.info.driver_info
         ),
-        settings: &format!("{} on {map_name}, {}", args.scene, plan.describe()),
+        settings: &format!("{} on {map_name}, {}", scene.name, plan.describe()),
         rows: &rows,
         masks: &mask_rows,
         clock: clock.name(),
@@ -441,6 +460,29 @@ fn gpu_points(rows: &[Row]) -> Vec<trade::Point> {
             Some(trade::Point { setting: r.name.clone(), ms: r.seconds * 1e3, rmse: r.rmse?, flip: r.flip? })
         })
         .collect()
+}
+
+/// How far the best GPU row of a model (a scene without thresholds) may be from the same lights
+/// ray traced, in RMSE.
+const MODEL_GOAL: f64 = 1.3;
+
+/// `best GPU row: ROW RMSE r / lights_ray_traced t = q x (goal Gx)` and whether it is met; the
+/// best is the least RMSE among the frame techniques ([`gpu_points`]' rows).
+fn best_gpu_line(rows: &[Row], goal: f64) -> Result<(String, bool), String> {
+    let traced = rows.iter().find(|r| r.name == "lights_ray_traced").and_then(|r| r.rmse);
+    let best = gpu_points(rows).into_iter().min_by(|a, b| a.rmse.total_cmp(&b.rmse));
+    let (Some(t), Some(b)) = (traced, best) else {
+        return Err("validate: no GPU row or no ray-traced lights to compare".into());
+    };
+    let ratio = b.rmse / t.max(f64::MIN_POSITIVE);
+    let ok = ratio <= goal;
+    let line = format!(
+        "  best GPU row: {} RMSE {:.4} / lights_ray_traced {t:.4} = {ratio:.2}x (goal {goal}x){}",
+        b.setting,
+        b.rmse,
+        if ok { "" } else { ": FAILED" }
+    );
+    Ok((line, ok))
 }
 
 /// The chooser over [`gpu_points`]: `budget: MS ms -> ROW (ms M, rmse R)`, or an error naming
@@ -480,5 +522,21 @@ mod tests {
         assert!(budget_line(&rows, 1e5).is_ok_and(|l| l.contains("-> gpu_wedges")));
         let e = budget_line(&rows, 100.0).expect_err("nothing fits 100 ms");
         assert!(e.contains("gpu_shadow_maps") && e.contains("2000.000 ms"), "{e}");
+    }
+
+    #[test]
+    fn a_models_best_gpu_row_is_held_to_the_goal() {
+        let rows = [
+            row("lights_ray_traced", 0.5, 0.010),
+            row("gpu_shadow_maps", 2.0, 0.03),
+            row("gpu_wedges", 9.0, 0.012),
+            row("gpu_traced_visibility", 1.0, 0.0101),
+        ];
+        let (line, ok) = best_gpu_line(&rows, 1.3).unwrap_or_else(|e| panic!("{e}"));
+        // traced visibility is not a frame technique: the wedges are the best row
+        assert!(ok && line.contains("gpu_wedges RMSE 0.0120") && line.contains("1.20x"), "{line}");
+        let (line, ok) = best_gpu_line(&rows, 1.1).unwrap_or_else(|e| panic!("{e}"));
+        assert!(!ok && line.ends_with("FAILED"), "{line}");
+        assert!(best_gpu_line(&rows[1..], 1.3).is_err(), "no ray-traced row");
     }
 }

@@ -1,8 +1,8 @@
-//! `cargo xtask scene NAME --obj OUT.obj`: a built-in scene's geometry as Wavefront OBJ.
+//! `envshadow scene NAME --obj OUT.obj`: a built-in scene's geometry as Wavefront OBJ.
 
 use std::path::Path;
 
-pub fn run(name: &str, obj: &Path) -> Result<(), String> {
+pub(crate) fn run(name: &str, obj: &Path) -> Result<(), String> {
     let scene = scene::Scene::builtin(name).map_err(|e| e.to_string())?;
     scene.write_obj(obj).map_err(|e| e.to_string())?;
     outln!(

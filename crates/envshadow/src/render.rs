@@ -1,7 +1,6 @@
-//! `cargo xtask render`: the reference tracer on a built-in scene, with a progress bar and one
-//! summary line; and `cargo xtask compare REF TEST`: RMSE and FLIP.
+//! `envshadow render`: the reference tracer on a built-in scene or a glTF model, with a progress bar and one
+//! summary line; and `envshadow compare REF TEST`: RMSE and FLIP.
 
-use crate::common::parse_size;
 use envmap_sphere::{EnvMap, LoadOptions, NegativePolicy, Sh9, Tonemap};
 use glam::Vec3;
 use light_extract::output::{LightsFile, read_lights_json};
@@ -10,6 +9,7 @@ use ref_tracer::{AmbientMap, EnvLight, Integrator, LightSet, RenderSettings, Sam
 use scene::{DistantLight, Scene};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
+use trade::args::parse_size;
 
 /// What `render` was asked for (parsed by clap).
 #[derive(clap::Args)]
@@ -24,10 +24,10 @@ pub struct RenderArgs {
     #[arg(long)]
     pub camera_index: Option<usize>,
     /// Camera position X,Y,Z (with --target), overriding the scene's camera.
-    #[arg(long, value_parser = crate::common::parse_vec3, requires = "target")]
+    #[arg(long, value_parser = trade::args::parse_vec3, requires = "target")]
     pub eye: Option<glam::Vec3>,
     /// Point looked at X,Y,Z (with --eye).
-    #[arg(long, value_parser = crate::common::parse_vec3, requires = "eye")]
+    #[arg(long, value_parser = trade::args::parse_vec3, requires = "eye")]
     pub target: Option<glam::Vec3>,
     /// Horizontal field of view in degrees (+Y up), overriding the scene's camera.
     #[arg(long)]
@@ -90,7 +90,7 @@ pub struct LightsData {
 /// Lights from a `lights.json` (the light-extract schema; `lights[]` and `interleaved[][]` with
 /// their `direction`, `solid_angle` and `radiance` are read) and, when an `ambient.exr` sits
 /// beside it, that map and its SH9.
-pub fn load_lights(path: &Path) -> Result<LightsData, String> {
+pub(crate) fn load_lights(path: &Path) -> Result<LightsData, String> {
     let LightsFile { lights, interleaved, .. } = read_lights_json(path).map_err(|e| e.to_string())?;
     let ambient_path = path.with_file_name("ambient.exr");
     // signed when it is a residual (`+residual`): negative values are data, not ringing
@@ -104,7 +104,7 @@ pub fn load_lights(path: &Path) -> Result<LightsData, String> {
     Ok(LightsData { lights, interleaved, ambient, ambient_map })
 }
 
-pub fn run(args: &RenderArgs) -> Result<(), String> {
+pub(crate) fn run(args: &RenderArgs) -> Result<(), String> {
     if let Some((w, h)) = args.size
         && (w == 0 || h == 0 || u64::from(w) * u64::from(h) > 1 << 26)
     {
@@ -142,7 +142,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     if args.spp == 0 {
         return Err("--spp must be at least 1".into());
     }
-    let map = crate::common::load_map(args.envmap.as_deref())?;
+    let map = trade::args::load_map(args.envmap.as_deref()).map_err(|e| e.to_string())?;
     let light_data = match &args.lights {
         Some(p) => Some(load_lights(p)?),
         None => None,
@@ -238,7 +238,7 @@ fn write_outputs(img: &ref_tracer::Render, args: &RenderArgs) -> Result<(), Stri
 }
 
 /// `compare`: RMSE and FLIP of TEST against REF, one per line.
-pub fn compare(reference: &Path, test: &Path) -> Result<(), String> {
+pub(crate) fn compare(reference: &Path, test: &Path) -> Result<(), String> {
     let a = envmap_sphere::load_rgb_image(reference).map_err(|e| e.to_string())?;
     let b = envmap_sphere::load_rgb_image(test).map_err(|e| e.to_string())?;
     if (a.width, a.height) != (b.width, b.height) {

@@ -1,4 +1,4 @@
-//! `cargo xtask composite`: a synthetic object composited into a built-in real scene's
+//! `envshadow composite`: a synthetic object composited into a built-in real scene's
 //! photograph on the GPU (paper 003), against the path-traced truth and Debevec's offline
 //! differential rendering: errors in 8-bit codes, time per frame, the images; `--sweep` for
 //! every passes x HDR/LDR setting and Figure 3, `--path` for a moving object.
@@ -13,7 +13,7 @@ use shaft_hierarchy::preprocess::PreprocessSettings;
 use trade::composite_rows::{figure3_datasets, ms, rows};
 use trade::{PhotoSettings, Session, SessionSettings};
 
-use crate::common::parse_size;
+use trade::args::parse_size;
 
 /// The command's options.
 #[derive(clap::Args)]
@@ -78,14 +78,14 @@ pub struct CompositeArgs {
     pub adapter: Option<String>,
 }
 
-pub fn run(args: &CompositeArgs) -> Result<(), String> {
+pub(crate) fn run(args: &CompositeArgs) -> Result<(), String> {
     let say = |s: &str| {
         if !args.json {
             outln!("{s}");
         }
     };
     let e = |e: differential_composite::CompositeError| e.to_string();
-    let at = crate::common::parse_vec3(&args.at).map_err(|e| format!("--at {e}"))?;
+    let at = trade::args::parse_vec3(&args.at).map_err(|e| format!("--at {e}"))?;
     let patch_maps = match args.patch_maps.as_str() {
         "paraboloid" => shadowmap_paraboloid::Technique::DualParaboloid,
         "cube" => shadowmap_paraboloid::Technique::Cube,
@@ -97,10 +97,11 @@ pub fn run(args: &CompositeArgs) -> Result<(), String> {
         patch_maps,
         layers_per_array: None,
     };
-    let gpu = crate::lavapipe::open_gpu(args.adapter.as_deref())?;
+    let gpu = open_gpu(args.adapter.as_deref())?;
     say(&format!("GPU: {}", gpu.describe()));
     let probe = RealScene::builtin(&args.scene).map_err(|e| e.to_string())?;
-    let (map, lights) = crate::common::environment(&probe)?;
+    let (map, lights) =
+        trade::session::environment(&probe, light_extract::DEFAULT_METHOD, 32).map_err(|e| e.to_string())?;
     let settings = SessionSettings {
         size: Some(args.size),
         photo: PhotoSettings { spp: args.spp, ..SessionSettings::default().photo },
@@ -274,4 +275,20 @@ fn moving(
         outln!("{}", serde_json::json!({"frames": out, "adapter": gpu.info.name}));
     }
     Ok(())
+}
+
+/// The GPU: `--adapter`, else `ENVSHADOW_ADAPTER`, else the best adapter present. Without any
+/// adapter, says how to get a software one (`cargo xtask test` installs it; a user tool
+/// installs nothing).
+fn open_gpu(adapter: Option<&str>) -> Result<gpu::Gpu, String> {
+    let opened = match adapter {
+        Some(name) => gpu::Gpu::with_adapter(Some(name)),
+        None => gpu::Gpu::new(),
+    };
+    opened.map_err(|e| match e {
+        gpu::GpuError::NoAdapter(_) => format!(
+            "{e}; for a software GPU install Mesa's lavapipe (Debian/Ubuntu: `apt install mesa-vulkan-drivers`)"
+        ),
+        other => other.to_string(),
+    })
 }

@@ -1,10 +1,10 @@
-//! `cargo xtask extract PATH [--method M] [--lights K] [--out DIR]`: decompose a map into
+//! `envshadow extract PATH [--method M] [--lights K] [--out DIR]`: decompose a map into
 //! lights + ambient and write lights.json, ambient.exr, lights.gltf and overlay.png.
 
 use light_extract::{METHODS, OPTIONS};
 use std::path::Path;
 
-pub fn run(path: &Path, method: &str, k: usize, out: Option<&Path>, lux_per_unit: f32) -> Result<(), String> {
+pub(crate) fn run(path: &Path, method: &str, k: usize, out: Option<&Path>, lux_per_unit: f32) -> Result<(), String> {
     let map = envmap_sphere::EnvMap::load(path).map_err(|e| e.to_string())?;
     // a method + our options, e.g. "+above-horizon": only the hemisphere above the ground
     let extractor = light_extract::extractor(method, k).ok_or_else(|| {

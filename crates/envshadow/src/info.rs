@@ -1,4 +1,4 @@
-//! `cargo xtask info PATH [--json]`: what a map is and holds.
+//! `envshadow info PATH [--json]`: what a map is and holds.
 
 use envmap_sphere::{EnvMap, LoadOptions, LoadReport, Sh9};
 use serde::Serialize;
@@ -82,7 +82,7 @@ impl MapInfo {
     }
 }
 
-pub fn run(path: &Path, json: bool) -> Result<(), String> {
+pub(crate) fn run(path: &Path, json: bool) -> Result<(), String> {
     let (map, report) = EnvMap::load_with(path, &LoadOptions::default()).map_err(|e| e.to_string())?;
     let info = MapInfo::new(&map, &report);
     if json {
