@@ -113,6 +113,14 @@ impl Frame {
     pub fn new(gpu: &Gpu, name: &str, size: (u32, u32)) -> Result<Self, String> {
         let mut scene = scene::Scene::builtin(name).map_err(|e| e.to_string())?;
         (scene.camera.width, scene.camera.height) = size;
+        Self::with_scene(gpu, scene)
+    }
+
+    /// Renders `scene`'s G-buffer at its camera's size.
+    ///
+    /// # Errors
+    /// GPU failures.
+    pub fn with_scene(gpu: &Gpu, scene: scene::Scene) -> Result<Self, String> {
         let geometry = SceneGeometry::upload(gpu, &scene).map_err(|e| e.to_string())?;
         let gbuffer = GBufferPass::new(gpu).render(gpu, &geometry, &scene.camera).map_err(|e| e.to_string())?;
         let points = gbuffer.read_points(gpu).map_err(|e| e.to_string())?;

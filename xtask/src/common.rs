@@ -7,6 +7,16 @@ use real_scene::RealScene;
 
 pub use trade::args::{load_map, parse_size};
 
+/// The scene `spec` names (built-in or glTF model) at `size`, a model on a ground of albedo
+/// `ground`; the import's warnings go to stderr (stdout may be a `--json` object).
+pub fn open_scene(spec: &str, size: (u32, u32), ground: Option<f32>) -> Result<scene::Scene, String> {
+    let (scene, warnings) = trade::args::open_scene(spec, size, ground).map_err(|e| e.to_string())?;
+    for w in warnings {
+        eprintln!("warning: {spec}: {w}");
+    }
+    Ok(scene)
+}
+
 /// An environment-lit scene's map (the embedded one) and its extracted lights as distant
 /// sources; nothing for a scene lit by its own patches.
 pub fn environment(scene: &RealScene) -> Result<(Option<EnvMap>, Vec<scene::DistantLight>), String> {

@@ -16,6 +16,8 @@ const MAX_REPEATS: usize = 10_000;
 /// What to time.
 pub struct FrameArgs<'a> {
     pub scene: &'a str,
+    /// For a model: the ground's albedo.
+    pub ground: Option<f32>,
     pub size: (u32, u32),
     pub repeats: usize,
     pub lights: usize,
@@ -41,7 +43,8 @@ pub fn run(args: &FrameArgs) -> Result<(), String> {
         outln!("GPU: {}", gpu.describe());
     }
     let map = crate::common::load_map(args.envmap).map_err(|e| e.to_string())?;
-    let mut frame = Frame::new(&gpu, args.scene, args.size, &map, args.lights)?;
+    let scene = crate::common::open_scene(args.scene, args.size, args.ground)?;
+    let mut frame = Frame::with_scene(&gpu, scene, &map, args.lights)?;
     let moving = args.animate.then(|| animated_object(&frame.scene));
     let d = &frame.decomposition;
     let (lights, directs) = (d.lights.len(), d.directs());

@@ -77,9 +77,13 @@ enum Command {
     /// its GPU time per light, per scene and light size (0.25 to 45 degrees), and each
     /// technique's speed at the wedges' error; OUT/soft_shadows.{csv,md}.
     SoftShadows {
-        /// Comma-separated built-in scenes; three_boxes, column and spheres_box when absent.
+        /// Comma-separated built-in scenes or glTF models (`.gltf`, `.glb`); three_boxes,
+        /// column and spheres_box when absent.
         #[arg(long, value_delimiter = ',')]
         scenes: Vec<String>,
+        /// For a model: a Lambertian ground plane under it (albedo 0.5, or the value given).
+        #[arg(long, num_args = 0..=1, default_missing_value = "0.5", value_parser = ::trade::args::parse_albedo)]
+        ground: Option<f32>,
         /// Image size WIDTHxHEIGHT.
         #[arg(long, value_parser = parse_size, default_value = "640x480")]
         size: (u32, u32),
@@ -94,9 +98,13 @@ enum Command {
     /// EnvIndirects' maps at 1, 1/2 and 1/4 resolution, joint bilateral upsampling, shading; the
     /// median and fastest ms per frame (and fps) of each.
     Frame {
-        /// Built-in scene (`gallery`: 161,794 triangles, paper 001's scale).
+        /// Built-in scene (`gallery`: 161,794 triangles, paper 001's scale) or a glTF model
+        /// (`.gltf`, `.glb`).
         #[arg(long, default_value = "gallery")]
         scene: String,
+        /// For a model: a Lambertian ground plane under it (albedo 0.5, or the value given).
+        #[arg(long, num_args = 0..=1, default_missing_value = "0.5", value_parser = ::trade::args::parse_albedo)]
+        ground: Option<f32>,
         /// Image size WIDTHxHEIGHT.
         #[arg(long, value_parser = parse_size, default_value = "1600x1200")]
         size: (u32, u32),
@@ -189,12 +197,13 @@ fn main() -> ExitCode {
             shafts::run(&shafts::ShaftsArgs { scene: &scene, json, settings, sweep, photo, out: &out })
         }
         Command::Trade(args) => trade::run(&args),
-        Command::SoftShadows { scenes, size, adapter, out } => {
-            soft_shadows::run(&scenes, size, adapter.as_deref(), &out)
+        Command::SoftShadows { scenes, ground, size, adapter, out } => {
+            soft_shadows::run(&scenes, ground, size, adapter.as_deref(), &out)
         }
-        Command::Frame { scene, size, repeats, lights, envmap, adapter, animate, json, scale } => {
+        Command::Frame { scene, ground, size, repeats, lights, envmap, adapter, animate, json, scale } => {
             frame::run(&frame::FrameArgs {
                 scene: &scene,
+                ground,
                 size,
                 repeats,
                 lights,

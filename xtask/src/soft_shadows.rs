@@ -7,8 +7,14 @@ use envshadow_benches::soft_shadows::{Frame, HALF_ANGLES, Row, SCENES, entries, 
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// Runs the sweep over `scenes` at `size` on `adapter` (or the best one).
-pub fn run(scenes: &[String], size: (u32, u32), adapter: Option<&str>, out: &Path) -> Result<(), String> {
+/// Runs the sweep over `scenes` (built-in or models, on a ground of albedo `ground`) at `size` on `adapter` (or the best one).
+pub fn run(
+    scenes: &[String],
+    ground: Option<f32>,
+    size: (u32, u32),
+    adapter: Option<&str>,
+    out: &Path,
+) -> Result<(), String> {
     let gpu = crate::lavapipe::open_gpu(adapter)?;
     outln!("GPU: {}", gpu.describe());
     let scenes: Vec<String> =
@@ -16,7 +22,7 @@ pub fn run(scenes: &[String], size: (u32, u32), adapter: Option<&str>, out: &Pat
     let mut rows: Vec<Row> = Vec::new();
     for name in &scenes {
         outln!("{name} at {}x{}", size.0, size.1);
-        let frame = Frame::new(&gpu, name, size)?;
+        let frame = Frame::with_scene(&gpu, crate::common::open_scene(name, size, ground)?)?;
         let list = entries(&gpu, &frame.scene).map_err(|e| e.to_string())?;
         rows.extend(measure(&gpu, &frame, &list, &HALF_ANGLES, &mut |r| {
             outln!(

@@ -29,12 +29,15 @@ pub struct TradeArgs {
     /// and ar_ground), for CI.
     #[arg(long)]
     quick: bool,
-    /// Comma-separated built-in scenes. A real scene (ar_room, ar_ground) is composited into;
+    /// Comma-separated built-in scenes or glTF models (`.gltf`, `.glb`). A real scene (ar_room, ar_ground) is composited into;
     /// a scene with point lights (room) is measured by its point lights; any other is lit by
     /// each map. When absent: spheres_box, glossy_set, three_boxes, column, room, ar_room and
     /// ar_ground (with --quick: spheres_box, three_boxes, room, ar_ground).
     #[arg(long, value_delimiter = ',')]
     scenes: Vec<String>,
+    /// For a model: a Lambertian ground plane under it (albedo 0.5, or the value given).
+    #[arg(long, num_args = 0..=1, default_missing_value = "0.5", value_parser = ::trade::args::parse_albedo)]
+    ground: Option<f32>,
     /// Comma-separated maps or folders of maps (`assets/envmaps` for the whole test set); when
     /// absent the embedded default map, st_fagans_interior (indoor) and kiara_1_dawn (a low
     /// sun), or with --quick the default map alone.
@@ -118,13 +121,13 @@ impl Unit {
 }
 
 /// The family a scene is measured in: composites for real scenes, point for scenes with point
-/// lights, env for the rest.
-fn family_of(scene: &str) -> Result<Family, String> {
-    if real_scene::BUILTIN_REAL_SCENES.contains(&scene) {
-        return Ok(Family::Composite);
+/// lights, env for the rest; with the scene opened at `size` (none for a real scene).
+fn family_of(spec: &str, size: (u32, u32), ground: Option<f32>) -> Result<(Family, Option<scene::Scene>), String> {
+    if real_scene::BUILTIN_REAL_SCENES.contains(&spec) {
+        return Ok((Family::Composite, None));
     }
-    let s = scene::Scene::builtin(scene).map_err(|e| format!("--scenes: {e}"))?;
-    Ok(if s.point_lights.is_empty() { Family::Env } else { Family::Point })
+    let s = crate::common::open_scene(spec, size, ground).map_err(|e| format!("--scenes: {e}"))?;
+    Ok((if s.point_lights.is_empty() { Family::Env } else { Family::Point }, Some(s)))
 }
 
 fn file_name(p: &Path) -> String {
@@ -191,13 +194,19 @@ pub fn run(args: &TradeArgs) -> Result<(), String> {
     };
     let mut env_scenes = Vec::new();
     let mut units = Vec::new();
+    let mut opened = std::collections::HashMap::new();
     for s in &scenes {
-        match family_of(s)? {
+        let (family, scene) = family_of(s, plan.size, args.ground)?;
+        match family {
             Family::Env => env_scenes.push(s.clone()),
             Family::Point => units.push(Unit::Point(s.clone())),
             Family::Composite => units.push(Unit::Composite(s.clone())),
         }
+        if let Some(scene) = scene {
+            opened.insert(s.clone(), scene);
+        }
     }
+    let opened_scene = |s: &str| opened.get(s).cloned().ok_or_else(|| format!("{s}: not opened"));
     if !env_scenes.is_empty() {
         units.extend(map_list(&args.maps, args.quick)?.into_iter().map(Unit::Map));
     }
@@ -249,13 +258,13 @@ pub fn run(args: &TradeArgs) -> Result<(), String> {
                 };
                 for scene in &env_scenes {
                     outln!("[{:>6.1} s] {scene} under {name}: truth", start.elapsed().as_secs_f64());
-                    let case = Case::new(scene, name, map.clone(), &plan).map_err(e)?;
+                    let case = Case::with_scene(opened_scene(scene)?, name, map.clone(), &plan);
                     run.rows.extend(trade::measure(&gpu, &case, &settings, &plan, &mut show).map_err(e)?);
                 }
             }
             Unit::Point(scene) => {
                 outln!("[{elapsed:>6.1} s] {scene}'s point lights: truth (ray-traced visibility)");
-                let case = PointCase::new(&gpu, &passes, scene, &plan).map_err(e)?;
+                let case = PointCase::with_scene(&gpu, &passes, opened_scene(scene)?, &plan).map_err(e)?;
                 run.rows.extend(trade::measure_point(&gpu, &case, &settings, &plan, &mut show).map_err(e)?);
             }
             Unit::Composite(scene) => {

@@ -18,7 +18,7 @@ pub struct RenderArgs {
     #[arg(long)]
     pub scene: String,
     /// For a model: a Lambertian ground plane under it (albedo 0.5, or the value given).
-    #[arg(long, num_args = 0..=1, default_missing_value = "0.5")]
+    #[arg(long, num_args = 0..=1, default_missing_value = "0.5", value_parser = trade::args::parse_albedo)]
     pub ground: Option<f32>,
     /// For a model: its N-th camera (0-based) instead of the first perspective one.
     #[arg(long)]
@@ -109,9 +109,6 @@ pub(crate) fn run(args: &RenderArgs) -> Result<(), String> {
         && (w == 0 || h == 0 || u64::from(w) * u64::from(h) > 1 << 26)
     {
         return Err(format!("--size {w}x{h}: each side at least 1 and at most 2^26 pixels in all"));
-    }
-    if args.ground.is_some_and(|a| !(0.0..=1.0).contains(&a)) {
-        return Err("--ground: an albedo in [0, 1]".into());
     }
     if args.fov.is_some_and(|f| !(f > 0.0 && f < 180.0)) {
         return Err("--fov: degrees in (0, 180)".into());

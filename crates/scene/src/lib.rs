@@ -72,20 +72,30 @@ pub enum SceneError {
     },
 }
 
+/// Whether `spec` names a model file rather than a built-in scene: a `.gltf` or `.glb` path,
+/// or any existing file that is not a built-in's name (the one rule [`Scene::open`] follows).
+#[must_use]
+pub fn is_model(spec: &str) -> bool {
+    let path = std::path::Path::new(spec);
+    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"))
+        || (!BUILTIN_SCENES.contains(&spec) && path.is_file())
+}
+
 impl Scene {
-    /// A built-in scene by name, or a glTF model by path (`.gltf`, `.glb`, or any existing file)
-    /// imported with `options`; the import's warnings come back with it (none for a built-in).
+    /// A built-in scene by name, or a glTF model by path (see [`is_model`]) imported with
+    /// `options`; either way its camera is `options.size`. The import's warnings come back
+    /// with it (none for a built-in).
     ///
     /// # Errors
     /// An unknown name; a model that cannot be imported.
     pub fn open(spec: &str, options: &import::GltfOptions) -> Result<(Self, Vec<String>), SceneError> {
-        let path = std::path::Path::new(spec);
-        let model = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"));
-        if model || (!BUILTIN_SCENES.contains(&spec) && path.is_file()) {
-            let import = import::load_gltf(path, options)?;
+        if is_model(spec) {
+            let import = import::load_gltf(std::path::Path::new(spec), options)?;
             return Ok((import.scene, import.warnings));
         }
-        Ok((Self::builtin(spec)?, Vec::new()))
+        let mut scene = Self::builtin(spec)?;
+        (scene.camera.width, scene.camera.height) = options.size;
+        Ok((scene, Vec::new()))
     }
 
     /// Total number of triangles.

@@ -1,5 +1,6 @@
 //! The values both command lines (`xtask`'s jobs and the `envshadow` tool) parse the same way:
-//! image sizes, points, and the map a command is given or the embedded default.
+//! image sizes, points, albedos, the scene a command is given (built-in or model) and its map
+//! (or the embedded default).
 
 use envmap_sphere::EnvMap;
 use glam::Vec3;
@@ -14,6 +15,9 @@ pub enum ArgError {
     /// Not three finite numbers `X,Y,Z`.
     #[error("{0:?}: expected three finite numbers X,Y,Z")]
     Vec3(String),
+    /// Not a number in [0, 1].
+    #[error("{0:?}: expected an albedo in [0, 1]")]
+    Albedo(String),
 }
 
 /// Parses `WIDTHxHEIGHT`.
@@ -39,6 +43,31 @@ pub fn parse_vec3(s: &str) -> Result<Vec3, ArgError> {
     }
 }
 
+/// Parses an albedo: a number in [0, 1] (`--ground`'s).
+///
+/// # Errors
+/// Not a number, or one outside [0, 1].
+pub fn parse_albedo(s: &str) -> Result<f32, ArgError> {
+    match s.trim().parse::<f32>() {
+        Ok(a) if (0.0..=1.0).contains(&a) => Ok(a),
+        _ => Err(ArgError::Albedo(s.to_string())),
+    }
+}
+
+/// The scene `spec` names (a built-in or a glTF model, [`scene::Scene::open`]) with its camera
+/// at `size`, a model standing on a ground of albedo `ground` when given; with the import's
+/// warnings, for the command to show.
+///
+/// # Errors
+/// An unknown name; a model that cannot be imported (the message names the file).
+pub fn open_scene(
+    spec: &str,
+    size: (u32, u32),
+    ground: Option<f32>,
+) -> Result<(scene::Scene, Vec<String>), scene::SceneError> {
+    scene::Scene::open(spec, &scene::import::GltfOptions { size, ground, ..Default::default() })
+}
+
 /// The map at `path` (`--envmap`), or the embedded default.
 ///
 /// # Errors
@@ -62,6 +91,10 @@ mod tests {
         assert_eq!(parse_vec3("1, 2,-3.5"), Ok(Vec3::new(1.0, 2.0, -3.5)));
         for bad in ["1,2", "1,2,3,4", "1,nan,2", "1,inf,2", "a,b,c"] {
             assert!(parse_vec3(bad).is_err(), "{bad}");
+        }
+        assert_eq!(parse_albedo("0.25"), Ok(0.25));
+        for bad in ["-0.1", "1.5", "nan", "x", "inf"] {
+            assert_eq!(parse_albedo(bad), Err(ArgError::Albedo(bad.into())), "{bad}");
         }
     }
 }

@@ -49,7 +49,7 @@ impl Plan {
 
 /// One scene under one map, with its truth.
 pub struct Case {
-    /// Built-in scene at the plan's size.
+    /// The scene at the plan's size.
     pub scene: scene::Scene,
     /// Map name for the tables.
     pub map_name: String,
@@ -67,7 +67,13 @@ impl Case {
     /// # Errors
     /// An unknown scene.
     pub fn new(scene_name: &str, map_name: &str, map: EnvMap, plan: &Plan) -> Result<Self, TradeError> {
-        let mut scene = scene::Scene::builtin(scene_name).map_err(|e| TradeError::Scene(e.to_string()))?;
+        let scene = scene::Scene::builtin(scene_name).map_err(|e| TradeError::Scene(e.to_string()))?;
+        Ok(Self::with_scene(scene, map_name, map, plan))
+    }
+
+    /// As [`Case::new`] for any scene (a model, say), its camera set to the plan's size.
+    #[must_use]
+    pub fn with_scene(mut scene: scene::Scene, map_name: &str, map: EnvMap, plan: &Plan) -> Self {
         (scene.camera.width, scene.camera.height) = plan.size;
         let bvh = SceneBvh::new(&scene);
         let env = EnvLight::new(&map);
@@ -79,7 +85,7 @@ impl Case {
         let (truth, second) = (render(1), render(2));
         let truth_noise = rmse(&truth, &second) / std::f64::consts::SQRT_2;
         let tonemap = FlipTonemap::for_reference(&truth);
-        Ok(Self { scene, map_name: map_name.into(), map, truth, truth_noise, tonemap })
+        Self { scene, map_name: map_name.into(), map, truth, truth_noise, tonemap }
     }
 
     /// The truth image.

@@ -36,9 +36,18 @@ impl PointCase {
     /// # Errors
     /// An unknown scene or one without point lights; GPU failures.
     pub fn new(gpu: &Gpu, passes: &Passes, scene_name: &str, plan: &Plan) -> Result<Self, TradeError> {
-        let mut scene = scene::Scene::builtin(scene_name).map_err(|e| TradeError::Scene(e.to_string()))?;
+        let scene = scene::Scene::builtin(scene_name).map_err(|e| TradeError::Scene(e.to_string()))?;
+        Self::with_scene(gpu, passes, scene, plan)
+    }
+
+    /// As [`PointCase::new`] for any scene with point lights (a model's `KHR_lights_punctual`
+    /// ones, say), its camera set to the plan's size.
+    ///
+    /// # Errors
+    /// A scene without point lights; GPU failures.
+    pub fn with_scene(gpu: &Gpu, passes: &Passes, mut scene: scene::Scene, plan: &Plan) -> Result<Self, TradeError> {
         if scene.point_lights.is_empty() {
-            return Err(TradeError::Scene(format!("{scene_name} has no point lights")));
+            return Err(TradeError::Scene(format!("{} has no point lights", scene.name)));
         }
         (scene.camera.width, scene.camera.height) = plan.size;
         let grid = RotatedGrid::new(&scene.camera, plan.supersample.max(1));

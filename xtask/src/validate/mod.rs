@@ -34,7 +34,7 @@ pub struct ValidateArgs {
     #[arg(long, default_value = "spheres_box")]
     pub scene: String,
     /// For a model: a Lambertian ground plane under it (albedo 0.5, or the value given).
-    #[arg(long, num_args = 0..=1, default_missing_value = "0.5")]
+    #[arg(long, num_args = 0..=1, default_missing_value = "0.5", value_parser = trade::args::parse_albedo)]
     pub ground: Option<f32>,
     /// Light extraction method (as `envshadow extract --method`); the default is the most
     /// accurate in `eval-lights`. Other methods' threshold keys carry the method.
@@ -209,7 +209,7 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
     );
     let options = scene::import::GltfOptions { size: plan.size, ground: args.ground, ..Default::default() };
     let (mut scene, warnings) = scene::Scene::open(&args.scene, &options).map_err(|e| e.to_string())?;
-    let model = !scene::BUILTIN_SCENES.contains(&args.scene.as_str());
+    let model = scene::is_model(&args.scene);
     for w in warnings {
         outln!("warning: {}: {w}", args.scene);
     }
