@@ -86,6 +86,7 @@ pub fn run(args: &FrameArgs) -> Result<(), String> {
         let skipped = gpu::skip_reasons(&reports);
         if args.json {
             let mut v = json(args, &gpu, &stats, moving.map(|k| frame.scene.objects[k].name.as_str()), lights);
+            v["triangles"] = frame.scene.triangle_count().into();
             v["lights_shadowed"] = (reports.len() - skipped.iter().map(|(_, n)| n).sum::<usize>()).into();
             v["lights_skipped"] = skipped.iter().map(|(why, n)| serde_json::json!({"why": why, "lights": n})).collect();
             outln!("{v}");

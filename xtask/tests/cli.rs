@@ -171,6 +171,18 @@ fn frame_json_counts_what_a_moving_frame_costs() {
     let skipped: u64 =
         v["lights_skipped"].as_array().map_or(0, |a| a.iter().filter_map(|s| s["lights"].as_u64()).sum());
     assert_eq!(v["lights_shadowed"].as_u64().map(|n| n + skipped), v["lights"].as_u64(), "{v}");
+    // a model's path in place of a built-in name, on its own ground
+    let dir = fresh_dir("cli-frame-model");
+    let model = dir.join("mine.glb");
+    scene::Scene::builtin("three_boxes").expect("built-in").write_gltf(&model).expect("writes");
+    let path = model.to_str().unwrap_or_default();
+    let out = xtask(&["frame", "--scene", path, "--ground", "0.3", "--size", "64x48", "--repeats", "1", "--json"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_str(text.trim()).unwrap_or_else(|e| panic!("{e}: {text}"));
+    assert_eq!((v["scene"].as_str(), v["triangles"].as_u64()), (Some(path), Some(38 + 2)), "{v}");
+    let out = xtask(&["frame", "--scene", path, "--ground", "2", "--size", "64x48"]);
+    assert_eq!(out.status.code(), Some(2), "clap refuses an albedo past 1");
     let out = xtask(&["frame", "--json", "--scale", "3", "--size", "64x48"]);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--scale 3"));
@@ -362,11 +374,15 @@ fn eval_lights_shards_merge_into_the_unsharded_run() {
 fn trade_writes_its_three_files_and_merges_them_back() {
     let dir = fresh_dir("cli-trade");
     let out = dir.join("run");
+    // a model of one's own beside the built-ins: three_boxes written as glTF and read back
+    let model = dir.join("mine.glb");
+    scene::Scene::builtin("three_boxes").expect("built-in").write_gltf(&model).expect("writes");
+    let scenes = format!("three_boxes,room,ar_ground,{}", model.display());
     let o = xtask(&[
         "trade",
         "--quick",
         "--scenes",
-        "three_boxes,room,ar_ground",
+        &scenes,
         "--size",
         "48x36",
         "--shard",
@@ -382,19 +398,16 @@ fn trade_writes_its_three_files_and_merges_them_back() {
     for column in ["setting", "scene", "map", "ms", "rmse", "flip", "pareto"] {
         assert!(header.contains(&column), "no {column} column: {header:?}");
     }
-    assert_eq!(csv.lines().count(), 1 + 11, "one row per quick setting of each scene's family: {csv}");
-    for family in [",env,three_boxes,", ",point,room,-,", ",composite,ar_ground,"] {
-        assert_eq!(
-            csv.lines().filter(|l| l.contains(family)).count(),
-            if family == ",env,three_boxes," { 7 } else { 2 }
-        );
+    assert_eq!(csv.lines().count(), 1 + 18, "one row per quick setting of each scene's family: {csv}");
+    for family in [",env,three_boxes,", ",point,room,-,", ",composite,ar_ground,", ",env,mine,"] {
+        assert_eq!(csv.lines().filter(|l| l.contains(family)).count(), if family.starts_with(",env,") { 7 } else { 2 });
         assert!(
             csv.lines().any(|l| l.contains(family) && l.contains(",true,")),
             "no {family} setting on its front: {csv}"
         );
     }
     let html = std::fs::read_to_string(out.join("report.html")).expect("report.html");
-    assert_eq!(html.matches("<svg").count(), 6, "per family a plot over all and one for its scene");
+    assert_eq!(html.matches("<svg").count(), 7, "per family a plot over all and one for each scene");
     let merged = dir.join("merged");
     let o = xtask(&["trade", "merge", out.to_str().unwrap_or_default(), "--out", merged.to_str().unwrap_or_default()]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));

@@ -36,14 +36,19 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Write a built-in scene's geometry (spheres_box, three_boxes, column, glossy_set, room).
-    #[command(after_help = "Example: envshadow scene room --obj room.obj")]
+    /// Write a built-in scene (spheres_box, three_boxes, column, glossy_set, room, gallery) as
+    /// Wavefront OBJ or glTF 2.0, for another renderer or to start a model of one's own from.
+    #[command(after_help = "Example: envshadow scene room --gltf room.glb --obj room.obj")]
     Scene {
         /// The scene's name.
         name: String,
         /// Output Wavefront OBJ file: one `o` per object, materials in comments.
+        #[arg(long, required_unless_present = "gltf")]
+        obj: Option<PathBuf>,
+        /// Output glTF file (`.glb`, or `.gltf` with a `.bin` beside it) that every command here
+        /// reads back as the same scene: camera, lights and GGX layers included.
         #[arg(long)]
-        obj: PathBuf,
+        gltf: Option<PathBuf>,
     },
     /// Render a built-in scene or a glTF model with the CPU reference tracer: OUT.exr, a tone-mapped OUT.png,
     /// and with --aovs OUT.albedo.exr, OUT.normal.exr, OUT.depth.exr, OUT.object.exr.
@@ -113,7 +118,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Info { path, json } => info::run(&path, json),
         Command::Composite(args) => composite::run(&args),
-        Command::Scene { name, obj } => scene::run(&name, &obj),
+        Command::Scene { name, obj, gltf } => scene::run(&name, obj.as_deref(), gltf.as_deref()),
         Command::Render(args) => render::run(&args),
         Command::Compare { reference, test } => render::compare(&reference, &test),
         Command::Extract { path, method, lights, out, lux_per_unit } => {

@@ -99,7 +99,7 @@ fn info_text_lists_the_statistics() {
 }
 
 #[test]
-fn scene_writes_obj_and_refuses_unknown_names() {
+fn scene_writes_obj_and_gltf_and_refuses_unknown_names() {
     let dir = fresh_dir("cli-scene");
     let obj = dir.join("spheres_box.obj");
     let out = envshadow(&["scene", "spheres_box", "--obj", obj.to_str().unwrap_or_default()]);
@@ -108,6 +108,21 @@ fn scene_writes_obj_and_refuses_unknown_names() {
     let text = std::fs::read_to_string(&obj).expect("OBJ written");
     assert_eq!(text.lines().filter(|l| l.starts_with("o ")).count(), 3);
     assert_eq!(text.lines().filter(|l| l.starts_with("f ")).count(), 20_494);
+    // the same scene as glTF: what `render --scene` reads back renders as the built-in does
+    let glb = dir.join("spheres_box.glb");
+    let out = envshadow(&["scene", "spheres_box", "--gltf", glb.to_str().unwrap_or_default()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let render = |scene: &str, name: &str| {
+        let exr = dir.join(name);
+        let args =
+            ["render", "--scene", scene, "--size", "32x24", "--spp", "1", "--out", exr.to_str().unwrap_or_default()];
+        let out = envshadow(&args);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        std::fs::read(dir.join(name.replace(".exr", ".png"))).expect("png")
+    };
+    assert!(render(glb.to_str().unwrap_or_default(), "a.exr") == render("spheres_box", "b.exr"), "the images differ");
+    let out = envshadow(&["scene", "spheres_box"]);
+    assert_eq!(out.status.code(), Some(2), "clap asks for --obj or --gltf");
     let out = envshadow(&["scene", "teapot", "--obj", obj.to_str().unwrap_or_default()]);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("unknown scene \"teapot\""));

@@ -3,17 +3,19 @@
 //! matrix transforms), every triangle primitive (strips and fans converted; points and lines
 //! skipped and counted), u8/u16/u32 indices, normals where the file has them (flat shading
 //! otherwise), the base colour factor as the albedo, the first perspective camera (else one that
-//! frames the model) and `KHR_lights_punctual` point lights.
+//! frames the model) and `KHR_lights_punctual` point lights; what [`Scene::write_gltf`] adds in
+//! `extras` (GGX layers, the exact camera and lights) where it agrees with the standard data.
 //!
 //! Every accessor is checked against its buffer view and buffer before it is read, so a file
 //! that lies about its sizes is an error, not a panic, and nothing is allocated past
 //! [`GltfOptions::max_triangles`]. What the file holds that is not modelled is listed in
 //! [`GltfImport::warnings`], once per kind.
 
-use crate::{Camera, Material, Mesh, Object, PointLight, Scene};
+use crate::{Camera, Ggx, Material, Mesh, Object, PointLight, Scene};
 use glam::{Affine3A, Mat4, Vec3};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
+use serde_json::Value;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
@@ -91,7 +93,8 @@ impl Default for GltfOptions {
 /// An imported file: its scene and what the import left out.
 #[derive(Clone, Debug)]
 pub struct GltfImport {
-    /// The scene, one object per primitive, named `mesh/primitive`.
+    /// The scene, one object per primitive, named after its node (else its mesh), with
+    /// `/k` for primitive k of a mesh of several, made unique with ` #2`, ` #3` …
     pub scene: Scene,
     /// What the file holds that is not modelled, one line per kind.
     pub warnings: Vec<String>,
@@ -182,7 +185,11 @@ impl Importer<'_> {
         let mut cameras = Vec::new();
         let mut lights = Vec::new();
         let mut triangles = 0usize;
+        // depth first in the document's order (the stack pops the last pushed first), so a
+        // written scene comes back with its objects in its own order
         let mut stack: Vec<(gltf::Node, Mat4)> = root.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
+        stack.reverse();
+        let mut names = BTreeSet::new();
         let mut visited = 0usize;
         while let Some((node, parent)) = stack.pop() {
             visited += 1;
@@ -194,8 +201,12 @@ impl Importer<'_> {
                 return Err(self.malformed(format!("node {} has a non-finite transform", node.index())));
             }
             if let Some(mesh) = node.mesh() {
+                let base = node.name().or(mesh.name()).map_or_else(|| format!("mesh {}", mesh.index()), str::to_string);
+                let several = mesh.primitives().len() > 1;
                 for primitive in mesh.primitives() {
-                    if let Some(object) = self.primitive(&mesh, &primitive, &world, &mut triangles)? {
+                    if let Some(mut object) = self.primitive(&mesh, &primitive, &world, &mut triangles)? {
+                        let name = if several { format!("{base}/{}", primitive.index()) } else { base.clone() };
+                        object.name = unique(&mut names, name);
                         objects.push(object);
                     }
                 }
@@ -206,7 +217,9 @@ impl Importer<'_> {
             if let Some(light) = node.light() {
                 lights.push((light, world));
             }
+            let first = stack.len();
             stack.extend(node.children().map(|c| (c, world)));
+            stack[first..].reverse();
         }
         if objects.is_empty() {
             return Err(GltfError::NoTriangles { path: self.path.to_path_buf(), degenerate: self.degenerate });
@@ -216,7 +229,16 @@ impl Importer<'_> {
             match light.kind() {
                 gltf::khr_lights_punctual::Kind::Point => {
                     let c = Vec3::from(light.color()) * light.intensity();
-                    point_lights.push(PointLight::point(world.transform_point3(Vec3::ZERO), c));
+                    let mut l = PointLight::point(world.transform_point3(Vec3::ZERO), c);
+                    // our own exact figures, where they say what the standard ones say
+                    if let Some(x) = ours(light.extras())
+                        && let Some(i) = x.get("intensity").and_then(vec3_of)
+                        && close(i, c, 1e-5 * c.max_element().max(1e-30))
+                    {
+                        l.intensity = i;
+                        l.radius = x.get("radius").and_then(Value::as_f64).map_or(0.0, |r| r as f32).max(0.0);
+                    }
+                    point_lights.push(l);
                 }
                 _ => {
                     self.warnings.insert("directional and spot lights are not modelled".into());
@@ -405,7 +427,12 @@ impl Importer<'_> {
         let mut mesh_out = Mesh { positions: local, normals: None, indices };
         if let Some(n) = normals {
             let m = crate::normal_matrix(glam::Mat3::from_mat4(*world));
-            mesh_out.normals = Some(n.into_iter().map(|v| (m * v).normalize_or(Vec3::Y)).collect());
+            // a normal already unit under an identity transform is kept as written, bit for bit
+            let unit = |v: Vec3| {
+                if (v.length_squared() - 1.0).abs() <= 4.0 * f32::EPSILON { v } else { v.normalize_or(Vec3::Y) }
+            };
+            mesh_out.normals =
+                Some(n.into_iter().map(|v| unit(if m == glam::Mat3::IDENTITY { v } else { m * v })).collect());
         }
         if affine.matrix3.determinant() < 0.0 {
             // a mirroring node: keep the winding counter-clockwise seen from outside
@@ -438,7 +465,15 @@ impl Importer<'_> {
         if pbr.metallic_factor() > 0.0 {
             self.warnings.insert("metallic and roughness are not modelled yet: surfaces are Lambertian".into());
         }
-        Material { albedo: Vec3::new(c[0], c[1], c[2]).clamp(Vec3::ZERO, Vec3::ONE), specular: None }
+        // a GGX layer as envshadow writes it
+        let specular = ours(m.extras()).and_then(|x| {
+            let g = x.get("ggx")?;
+            let roughness = g.get("roughness")?.as_f64()? as f32;
+            let f0 = vec3_of(g.get("f0")?)?;
+            (roughness > 0.0 && roughness <= 1.0 && f0.cmpge(Vec3::ZERO).all() && f0.cmple(Vec3::ONE).all())
+                .then_some(Ggx { roughness, f0 })
+        });
+        Material { albedo: Vec3::new(c[0], c[1], c[2]).clamp(Vec3::ZERO, Vec3::ONE), specular }
     }
 
     fn camera(&mut self, cameras: &[(gltf::Camera, Mat4)], lo: Vec3, hi: Vec3) -> Result<Camera, GltfError> {
@@ -456,12 +491,67 @@ impl Importer<'_> {
                 let forward = world.transform_vector3(Vec3::NEG_Z).normalize_or(Vec3::NEG_Z);
                 let up = world.transform_vector3(Vec3::Y).normalize_or(Vec3::Y);
                 let hfov = 2.0 * ((p.yfov() * 0.5).tan() * aspect).atan();
-                return Ok(Camera { eye, target: eye + forward, up, hfov_degrees: hfov.to_degrees(), width, height });
+                let mut c = Camera { eye, target: eye + forward, up, hfov_degrees: hfov.to_degrees(), width, height };
+                // the exact camera envshadow wrote, where it is the camera the node and the
+                // projection describe (the field of view as the file's aspect gives it)
+                if let Some(x) = ours(camera.extras())
+                    && let (Some(e), Some(t), Some(u), Some(h)) = (
+                        x.get("eye").and_then(vec3_of),
+                        x.get("target").and_then(vec3_of),
+                        x.get("up").and_then(vec3_of),
+                        x.get("hfov_degrees").and_then(Value::as_f64).map(|h| h as f32),
+                    )
+                {
+                    let scale = e.abs().max_element().max(1.0);
+                    let file_aspect = p.aspect_ratio().unwrap_or(aspect);
+                    let file_hfov = (2.0 * ((p.yfov() * 0.5).tan() * file_aspect).atan()).to_degrees();
+                    if close(e, eye, 1e-5 * scale)
+                        && close((t - e).normalize_or_zero(), forward, 1e-4)
+                        && u.cross(forward).length() > 1e-3
+                        && (h - file_hfov).abs() < 1e-3
+                        && h > 0.0
+                        && h < 180.0
+                    {
+                        (c.eye, c.target, c.up) = (e, t, u);
+                        c.hfov_degrees = if (file_aspect - aspect).abs() <= 1e-6 * aspect { h } else { c.hfov_degrees };
+                    }
+                }
+                return Ok(c);
             }
             self.warnings.insert("orthographic cameras are not modelled: a framing camera is used".into());
         }
         Ok(framing_camera(lo, hi, (width, height)))
     }
+}
+
+/// `name`, or `name #2`, `name #3` … where it is taken.
+fn unique(names: &mut BTreeSet<String>, name: String) -> String {
+    let mut out = name.clone();
+    let mut k = 1;
+    while !names.insert(out.clone()) {
+        k += 1;
+        out = format!("{name} #{k}");
+    }
+    out
+}
+
+/// What `extras.envshadow` holds, if anything.
+fn ours(extras: &gltf::json::Extras) -> Option<Value> {
+    let raw = extras.as_ref()?;
+    let mut v: Value = serde_json::from_str(raw.get()).ok()?;
+    v.get_mut(crate::export::EXTRAS_KEY).map(Value::take)
+}
+
+/// Three finite numbers.
+fn vec3_of(v: &Value) -> Option<Vec3> {
+    let a = v.as_array()?;
+    let f = |k: usize| a.get(k).and_then(Value::as_f64).map(|x| x as f32);
+    let out = Vec3::new(f(0)?, f(1)?, f(2)?);
+    (a.len() == 3 && out.is_finite()).then_some(out)
+}
+
+fn close(a: Vec3, b: Vec3, tolerance: f32) -> bool {
+    (a - b).abs().max_element() <= tolerance
 }
 
 /// Bounds of every vertex of `objects`.

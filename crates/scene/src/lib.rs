@@ -12,6 +12,7 @@
 pub mod brdf;
 mod builtin;
 mod camera;
+mod export;
 pub mod import;
 mod light;
 mod material;

@@ -289,3 +289,13 @@ fn bad_files_are_errors_naming_the_file() {
     let e = load_gltf(&path, &GltfOptions { max_triangles: 11, ..GltfOptions::default() }).expect_err("over the limit");
     assert!(e.to_string().contains("more than 11 triangles"), "{e}");
 }
+
+#[test]
+fn is_model_tells_model_paths_from_builtin_names() {
+    assert!(!scene::is_model("spheres_box") && !scene::is_model("nowhere"));
+    assert!(scene::is_model("nowhere.glb") && scene::is_model("a/b.GLTF"));
+    let d = dir("is-model");
+    let file = d.join("model");
+    std::fs::write(&file, "{}").expect("write");
+    assert!(scene::is_model(file.to_str().unwrap_or_default()), "an existing file is a model, whatever its name");
+}
