@@ -1,7 +1,8 @@
 //! Synthetic objects and their soft shadows composited into a photograph of a real scene
 //! (paper 003, Sections 7-9; Debevec 1998).
 //!
-//! - [`object`]: the built-in synthetic objects and their simplified shadow meshes.
+//! - [`object`]: the synthetic objects (built in, or a glTF model fitted to the scene) and
+//!   their simplified shadow meshes.
 //! - [`compositor`]: what the interactive compositor knows of the scene (each pixel's receiver,
 //!   transfers in RGB) and each frame's representatives with their radiance transfers (HDR)
 //!   and intensity transfers (LDR).
@@ -28,7 +29,7 @@ pub mod object;
 
 pub use compositor::{Compositor, FrameTransfers, PixelRef, RepTransfer};
 pub use metrics::{CodeError, code_error};
-pub use object::{BUILTIN_OBJECTS, SyntheticObject};
+pub use object::{BUILTIN_OBJECTS, MODEL_SIZE, Shape, SyntheticObject};
 
 /// Which framebuffer the compositor subtracts in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -51,6 +52,9 @@ pub enum CompositeError {
     /// The real scene refused (unknown name, a map missing or not wanted).
     #[error(transparent)]
     Scene(#[from] real_scene::RealSceneError),
+    /// A model that could not be imported (the message names the file).
+    #[error(transparent)]
+    Model(#[from] scene::SceneError),
     /// The shaft hierarchy could not be built.
     #[error(transparent)]
     Build(#[from] shaft_hierarchy::BuildError),

@@ -1,5 +1,5 @@
-//! Built-in synthetic objects: what is composited into the photograph, with the simplified mesh
-//! its shadows are cast from (paper 003, Section 7.2: 100-500 triangles).
+//! Synthetic objects, built in or a user's model: what is composited into the photograph, with
+//! the simplified mesh its shadows are cast from (paper 003, Section 7.2: 100-500 triangles).
 
 use glam::Vec3;
 use scene::Mesh;
@@ -21,10 +21,26 @@ pub struct SyntheticObject {
     pub albedo: Vec3,
     /// Its centre.
     pub centre: Vec3,
+    /// What it is, which decides its shadow mesh.
+    pub shape: Shape,
+}
+
+/// What a synthetic object is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shape {
+    /// The built-in sphere: its shadow mesh is re-tessellated at the asked detail.
+    Sphere,
+    /// The built-in box.
+    Box,
+    /// A user's model: its shadow mesh is its own mesh.
+    Model,
 }
 
 /// Radius of the built-in sphere and half the side of the built-in box, metres.
 pub const SIZE: f32 = 0.3;
+
+/// The side of the cube a model is fitted into by default: the built-ins' size (0.6 m).
+pub const MODEL_SIZE: f32 = 2.0 * SIZE;
 
 impl SyntheticObject {
     /// A built-in object centred at `centre` (world coordinates): `sphere` (radius 0.3 m, 484
@@ -37,19 +53,124 @@ impl SyntheticObject {
         if !centre.is_finite() {
             return Err(CompositeError::Parameter(format!("object centre {centre} is not finite")));
         }
-        let mesh = match name {
-            "sphere" => uv_sphere(centre, SIZE, 22, 12),
-            "box" => Mesh::cuboid(centre - Vec3::splat(SIZE), centre + Vec3::splat(SIZE)),
+        let (mesh, shape) = match name {
+            "sphere" => (uv_sphere(centre, SIZE, 22, 12), Shape::Sphere),
+            "box" => (Mesh::cuboid(centre - Vec3::splat(SIZE), centre + Vec3::splat(SIZE)), Shape::Box),
             _ => return Err(CompositeError::UnknownObject(name.to_string())),
         };
-        Ok(Self { name: name.to_string(), mesh, albedo: Vec3::new(0.7, 0.7, 0.65), centre })
+        Ok(Self { name: name.to_string(), mesh, albedo: Vec3::new(0.7, 0.7, 0.65), centre, shape })
+    }
+
+    /// A built-in object's name or a glTF model's path (see [`scene::is_model`]): the built-in
+    /// centred at `centre`, the model fitted by [`SyntheticObject::from_scene`] into a cube of
+    /// side `model_size` centred there. What the compositor does not model comes back as
+    /// warnings, with the import's own.
+    ///
+    /// # Errors
+    /// As [`SyntheticObject::builtin`] and [`SyntheticObject::from_scene`]; a model that
+    /// cannot be imported ([`CompositeError::Model`], naming the file).
+    pub fn open(spec: &str, centre: Vec3, model_size: f32) -> Result<(Self, Vec<String>), CompositeError> {
+        if !scene::is_model(spec) {
+            return Ok((Self::builtin(spec, centre)?, Vec::new()));
+        }
+        let import = scene::import::load_gltf(std::path::Path::new(spec), &scene::import::GltfOptions::default())
+            .map_err(scene::SceneError::from)?;
+        let name =
+            std::path::Path::new(spec).file_stem().map_or_else(|| spec.to_string(), |s| s.to_string_lossy().into());
+        let (object, mut warnings) = Self::from_scene(&name, &import.scene, centre, model_size)?;
+        let mut all = import.warnings;
+        all.append(&mut warnings);
+        Ok((object, all))
+    }
+
+    /// A scene's objects as one synthetic object: uniformly scaled so that the largest side of
+    /// its bounding box is `size`, centred at `centre` across (x, z) and resting on the bottom
+    /// of the `size` cube centred there (at `centre.y - size / 2`, where the built-ins rest),
+    /// so that the default position sets it on the floor. The compositor shades one Lambertian
+    /// material: the albedo is the objects' area-weighted mean, and what that leaves out
+    /// (specular layers, the scene's point lights) is returned as warnings.
+    ///
+    /// # Errors
+    /// [`CompositeError::Parameter`] for a centre or size that is not finite and positive, or
+    /// a scene without triangles or without extent.
+    pub fn from_scene(
+        name: &str,
+        scene: &scene::Scene,
+        centre: Vec3,
+        size: f32,
+    ) -> Result<(Self, Vec<String>), CompositeError> {
+        if !centre.is_finite() {
+            return Err(CompositeError::Parameter(format!("object centre {centre} is not finite")));
+        }
+        if !(size.is_finite() && size > 0.0) {
+            return Err(CompositeError::Parameter(format!("object size {size} is not finite and positive")));
+        }
+        let mut mesh = Mesh::default();
+        let (mut weighted, mut area) = (Vec3::ZERO, 0.0f64);
+        for o in &scene.objects {
+            mesh.append(&o.mesh);
+            let a = f64::from(o.mesh.area());
+            if a.is_finite() {
+                weighted += o.material.albedo * a as f32;
+                area += a;
+            }
+        }
+        if mesh.indices.is_empty() {
+            return Err(CompositeError::Parameter(format!("{name}: no triangles to composite")));
+        }
+        let (lo, hi) =
+            mesh.positions.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+        let extent = (hi - lo).max_element();
+        if !(extent.is_finite() && extent > 0.0) {
+            return Err(CompositeError::Parameter(format!("{name}: extent {extent} cannot be fitted")));
+        }
+        let scale = size / extent;
+        // the bounding box's bottom centre goes to the bottom centre of the cube
+        let anchor = Vec3::new(0.5 * (lo.x + hi.x), lo.y, 0.5 * (lo.z + hi.z));
+        let target = centre - Vec3::new(0.0, 0.5 * size, 0.0);
+        mesh.transform(&glam::Affine3A::from_scale_rotation_translation(
+            Vec3::splat(scale),
+            glam::Quat::IDENTITY,
+            target - anchor * scale,
+        ));
+        let albedo = if area > 0.0 { weighted / area as f32 } else { Vec3::splat(0.5) };
+        let mut warnings = Vec::new();
+        let glossy = scene.objects.iter().filter(|o| o.material.specular.is_some()).count();
+        if glossy > 0 {
+            warnings.push(format!("{glossy} objects' specular layers are not composited (Lambertian only)"));
+        }
+        if !scene.point_lights.is_empty() {
+            warnings.push(format!("its {} point lights are not composited", scene.point_lights.len()));
+        }
+        let bounds_centre =
+            mesh.positions.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+        let centre = 0.5 * (bounds_centre.0 + bounds_centre.1);
+        Ok((
+            Self {
+                name: name.to_string(),
+                mesh,
+                albedo: albedo.clamp(Vec3::ZERO, Vec3::ONE),
+                centre,
+                shape: Shape::Model,
+            },
+            warnings,
+        ))
+    }
+
+    /// The same object moved by `offset` (mesh and centre).
+    #[must_use]
+    pub fn moved(&self, offset: Vec3) -> Self {
+        let mut moved = self.clone();
+        moved.mesh.positions.iter_mut().for_each(|p| *p += offset);
+        moved.centre += offset;
+        moved
     }
 
     /// The mesh its shadows are cast from: the sphere at `detail` (slices; stacks half that,
-    /// about detail^2 triangles), the box as it is. The knob of paper 003's simplified objects.
+    /// about detail^2 triangles), the box and a model as they are. The knob of paper 003's simplified objects.
     #[must_use]
     pub fn shadow_mesh(&self, detail: u32) -> Mesh {
-        if self.name == "sphere" {
+        if self.shape == Shape::Sphere {
             let slices = detail.max(3);
             uv_sphere(self.centre, SIZE, slices, (slices / 2).max(2))
         } else {
@@ -137,5 +258,89 @@ mod tests {
         assert_eq!(sphere.shadow_mesh(10).indices.len(), 2 * 10 * 4);
         assert!(matches!(SyntheticObject::builtin("teapot", Vec3::ZERO), Err(CompositeError::UnknownObject(_))));
         assert!(matches!(SyntheticObject::builtin("box", Vec3::NAN), Err(CompositeError::Parameter(_))));
+    }
+
+    fn cube_object(name: &str, lo: Vec3, hi: Vec3, albedo: f32) -> scene::Object {
+        scene::Object { name: name.into(), mesh: Mesh::cuboid(lo, hi), material: scene::Material::lambert(albedo) }
+    }
+
+    fn two_cubes(scale: f32) -> scene::Scene {
+        let mut s = scene::Scene::builtin("three_boxes").unwrap_or_else(|e| panic!("{e}"));
+        s.objects = vec![
+            cube_object("small", Vec3::ZERO * scale, Vec3::ONE * scale, 0.2),
+            cube_object("large", Vec3::new(3.0, 0.0, 0.0) * scale, Vec3::new(5.0, 2.0, 2.0) * scale, 0.8),
+        ];
+        s.point_lights.clear();
+        s
+    }
+
+    fn bounds_of(m: &Mesh) -> (Vec3, Vec3) {
+        m.positions.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)))
+    }
+
+    #[test]
+    fn a_model_is_fitted_into_the_cube_on_its_floor_at_every_scale() {
+        let centre = Vec3::new(2.5, 0.3, 2.0);
+        for scale in [1e-4, 1.0, 1e6] {
+            let (o, warnings) = SyntheticObject::from_scene("cubes", &two_cubes(scale), centre, MODEL_SIZE)
+                .unwrap_or_else(|e| panic!("{e}"));
+            assert!(warnings.is_empty(), "{warnings:?}");
+            o.mesh.validate().unwrap_or_else(|e| panic!("scale {scale}: {e}"));
+            assert_eq!(o.mesh.indices.len(), 24);
+            let (lo, hi) = bounds_of(&o.mesh);
+            let close = |a: f32, b: f32| (a - b).abs() < 1e-5;
+            // the largest side (x: 5 units) is the size; the others keep their proportions
+            assert!(close(hi.x - lo.x, MODEL_SIZE) && close(hi.y - lo.y, 0.4 * MODEL_SIZE), "scale {scale}: {lo} {hi}");
+            // on the cube's floor, centred across it
+            assert!(close(lo.y, centre.y - 0.5 * MODEL_SIZE), "scale {scale}: bottom {}", lo.y);
+            assert!(close(0.5 * (lo.x + hi.x), centre.x) && close(0.5 * (lo.z + hi.z), centre.z), "{lo} {hi}");
+            assert!((o.centre - 0.5 * (lo + hi)).length() < 1e-5);
+            // area-weighted albedo: (0.2 * 6 + 0.8 * 24) / 30
+            assert!((o.albedo - Vec3::splat(0.68)).abs().max_element() < 1e-5, "{}", o.albedo);
+            assert_eq!(o.shape, Shape::Model);
+            assert_eq!(o.shadow_mesh(4), o.mesh, "a model casts with its own mesh");
+        }
+    }
+
+    #[test]
+    fn a_model_fitted_at_the_builtins_size_is_the_builtin_box() {
+        let centre = Vec3::new(-1.0, 0.3, 0.5);
+        let builtin = SyntheticObject::builtin("box", centre).unwrap_or_else(|e| panic!("{e}"));
+        let mut s = two_cubes(1.0);
+        s.objects = vec![cube_object("box", Vec3::splat(-7.0), Vec3::splat(-4.0), 0.5)];
+        let (o, _) = SyntheticObject::from_scene("box", &s, centre, MODEL_SIZE).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(o.mesh.indices, builtin.mesh.indices);
+        for (a, b) in o.mesh.positions.iter().zip(&builtin.mesh.positions) {
+            assert!((*a - *b).length() < 1e-6, "{a} vs {b}");
+        }
+        assert!((o.centre - builtin.centre).length() < 1e-6);
+    }
+
+    #[test]
+    fn what_a_model_cannot_be_is_refused_and_what_is_left_out_is_said() {
+        let good = two_cubes(1.0);
+        for (centre, size) in [(Vec3::NAN, 0.6), (Vec3::ZERO, 0.0), (Vec3::ZERO, -1.0), (Vec3::ZERO, f32::INFINITY)] {
+            assert!(matches!(SyntheticObject::from_scene("m", &good, centre, size), Err(CompositeError::Parameter(_))));
+        }
+        let mut empty = good.clone();
+        empty.objects.clear();
+        assert!(matches!(SyntheticObject::from_scene("m", &empty, Vec3::ZERO, 0.6), Err(CompositeError::Parameter(_))));
+        let mut point = good.clone();
+        point.objects[0].mesh.positions.iter_mut().for_each(|p| *p = Vec3::ONE);
+        point.objects.truncate(1);
+        assert!(matches!(SyntheticObject::from_scene("m", &point, Vec3::ZERO, 0.6), Err(CompositeError::Parameter(_))));
+        let glossy = scene::Scene::builtin("glossy_set").unwrap_or_else(|e| panic!("{e}"));
+        let (_, warnings) =
+            SyntheticObject::from_scene("g", &glossy, Vec3::ZERO, 0.6).unwrap_or_else(|e| panic!("{e}"));
+        assert!(warnings.iter().any(|w| w.contains("specular")), "{warnings:?}");
+        let mut lit = good;
+        lit.point_lights = vec![scene::PointLight::point(Vec3::Y, Vec3::ONE)];
+        let (_, warnings) = SyntheticObject::from_scene("l", &lit, Vec3::ZERO, 0.6).unwrap_or_else(|e| panic!("{e}"));
+        assert!(warnings.iter().any(|w| w.contains("1 point lights")), "{warnings:?}");
+        // a moved object keeps its shape
+        let b = SyntheticObject::builtin("box", Vec3::ZERO).unwrap_or_else(|e| panic!("{e}"));
+        let m = b.moved(Vec3::X);
+        assert_eq!(m.centre, Vec3::X);
+        assert!(m.mesh.positions.iter().zip(&b.mesh.positions).all(|(p, q)| *p == *q + Vec3::X));
     }
 }

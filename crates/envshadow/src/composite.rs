@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use differential_composite::gpu::{GpuCompositor, GpuSettings};
-use differential_composite::{Mode, code_error};
+use differential_composite::{Mode, SyntheticObject, code_error};
 use glam::Vec3;
 use real_scene::{Perturbation, RealScene};
 use shaft_hierarchy::preprocess::PreprocessSettings;
@@ -21,9 +21,13 @@ pub struct CompositeArgs {
     /// The built-in real scene (ar_room, ar_ground).
     #[arg(long, default_value = "ar_room")]
     pub scene: String,
-    /// The built-in object (sphere, box).
+    /// The object: a built-in (sphere, box) or a glTF model's path (.gltf, .glb), fitted into
+    /// a cube of --object-size resting on the floor at --at.
     #[arg(long, default_value = "sphere")]
     pub object: String,
+    /// A model's size: the largest side of its bounding box, metres (built-ins keep theirs).
+    #[arg(long, default_value_t = differential_composite::MODEL_SIZE)]
+    pub object_size: f32,
     /// The object's centre X,Y,Z in metres from the floor's centre (y up).
     #[arg(long, default_value = "0,0.3,0.5", allow_hyphen_values = true)]
     pub at: String,
@@ -100,6 +104,12 @@ pub(crate) fn run(args: &CompositeArgs) -> Result<(), String> {
     let gpu = open_gpu(args.adapter.as_deref())?;
     say(&format!("GPU: {}", gpu.describe()));
     let probe = RealScene::builtin(&args.scene).map_err(|e| e.to_string())?;
+    // the object first: a bad model is refused before the capture's minutes
+    let (object, warnings) =
+        SyntheticObject::open(&args.object, probe.floor_centre() + at, args.object_size).map_err(e)?;
+    for w in warnings {
+        eprintln!("warning: {}: {w}", args.object);
+    }
     let (map, lights) =
         trade::session::environment(&probe, light_extract::DEFAULT_METHOD, 32).map_err(|e| e.to_string())?;
     let settings = SessionSettings {
@@ -131,9 +141,8 @@ pub(crate) fn run(args: &CompositeArgs) -> Result<(), String> {
     let gc = GpuCompositor::new(&gpu, c).map_err(|e| e.to_string())?;
     let mode = if args.ldr { Mode::Ldr } else { Mode::Hdr };
     if let Some(frames) = args.path {
-        return moving(args, (&gpu, &gc, &gpu_settings), &session, (at, frames.max(1)), mode);
+        return moving(args, (&gpu, &gc, &gpu_settings), &session, (&object, at, frames.max(1)), mode);
     }
-    let object = session.object(&args.object, at).map_err(e)?;
     let t = std::time::Instant::now();
     let truth = session.truth(&object).map_err(e)?;
     let debevec = session.debevec(&object).map_err(e)?;
@@ -242,7 +251,7 @@ fn moving(
     args: &CompositeArgs,
     (gpu, gc, settings): (&gpu::Gpu, &GpuCompositor, &GpuSettings),
     session: &Session,
-    (start, frames): (Vec3, usize),
+    (object, start, frames): (&SyntheticObject, Vec3, usize),
     mode: Mode,
 ) -> Result<(), String> {
     let e = |e: differential_composite::CompositeError| e.to_string();
@@ -250,8 +259,9 @@ fn moving(
     let mut out = Vec::new();
     for k in 0..frames {
         let s = if frames > 1 { k as f32 / (frames - 1) as f32 } else { 0.0 };
-        let at = start + Vec3::new(-1.0 + 2.0 * s, 0.0, 0.0);
-        let object = session.object(&args.object, at).map_err(e)?;
+        let offset = Vec3::new(-1.0 + 2.0 * s, 0.0, 0.0);
+        let at = start + offset;
+        let object = object.moved(offset);
         let frame = c.frame(&object, args.passes);
         let (image, times, _) = gc.composite(gpu, c, &frame, &object, mode, settings).map_err(|e| e.to_string())?;
         let truth = session.truth(&object).map_err(e)?;

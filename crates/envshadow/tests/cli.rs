@@ -310,6 +310,52 @@ fn composite_json_has_the_interface_keys_and_writes_the_images() {
     }
 }
 
+#[test]
+fn composite_takes_a_model_fitted_where_the_builtin_would_stand() {
+    // a box of another size, elsewhere, with the built-in box's albedo, as a .glb: fitted into
+    // the 0.6 m cube at --at, it is the built-in box, so the composite and its error agree
+    let dir = fresh_dir("cli-composite-model");
+    let mut model = scene::Scene::builtin("three_boxes").expect("three_boxes");
+    model.objects = vec![scene::Object {
+        name: "crate".into(),
+        mesh: scene::Mesh::cuboid(glam::Vec3::splat(-7.0), glam::Vec3::splat(-4.0)),
+        material: scene::Material { albedo: glam::Vec3::new(0.7, 0.7, 0.65), specular: None },
+    }];
+    let glb = dir.join("crate.glb");
+    model.write_gltf(&glb).expect("write crate.glb");
+    let glb = glb.to_str().unwrap_or_default();
+    let composite = |object: &str, extra: &[&str]| {
+        let args = ["composite", "--scene", "ar_ground", "--at", "0,0.3,1", "--passes", "10", "--size", "64x48"];
+        let out = dir.join(format!("{}.png", extra.len()));
+        let run = envshadow(
+            &[
+                &args[..],
+                &["--spp", "8", "--json", "--object", object, "--out", out.to_str().unwrap_or_default()],
+                extra,
+            ]
+            .concat(),
+        );
+        assert!(run.status.success(), "{object}: {}", String::from_utf8_lossy(&run.stderr));
+        serde_json::from_slice::<serde_json::Value>(&run.stdout).expect("JSON")
+    };
+    let (builtin, fitted, larger) =
+        (composite("box", &[]), composite(glb, &[]), composite(glb, &["--object-size", "1.2"]));
+    for k in ["error_mae_codes", "error_rmse_codes", "debevec_error_mae_codes"] {
+        let (a, b) = (builtin[k].as_f64().unwrap_or(f64::NAN), fitted[k].as_f64().unwrap_or(f64::NAN));
+        assert!((a - b).abs() < 0.02 * a.max(0.1), "{k}: built-in box {a}, fitted model {b}");
+    }
+    assert_ne!(builtin["debevec_error_mae_codes"], larger["debevec_error_mae_codes"], "--object-size changed nothing");
+    // a model that cannot be read is refused before the capture, naming the file
+    let missing = dir.join("missing.glb");
+    for (object, want) in [(missing.to_str().unwrap_or_default(), "missing.glb"), (glb, "size")] {
+        let size = if object == glb { "0" } else { "0.6" };
+        let run = envshadow(&["composite", "--scene", "ar_ground", "--object", object, "--object-size", size]);
+        assert_eq!(run.status.code(), Some(1), "{object}");
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert!(err.trim().lines().count() == 1 && err.contains(want), "{err}");
+    }
+}
+
 /// A unit cube [0, 1]³ as `cube.gltf` + `cube.bin` in `dir`.
 fn write_cube_gltf(dir: &Path) -> PathBuf {
     let mut bin: Vec<u8> = (0..8)
