@@ -115,6 +115,7 @@ fn fuzz_short_run_finds_nothing() {
     assert!(last.starts_with("fuzz: 5000 cases, 0 panics, 0 errors not one line naming the file"), "{last}");
     // every target ran, and some cases were refused and some loaded
     assert!(text.contains("thresholds.json") && text.contains("lights.json") && text.contains("map.exr"), "{text}");
+    assert!(text.contains("model.gltf") && text.contains("model.glb"), "{text}");
 }
 
 #[test]

@@ -2,7 +2,8 @@
 //! `cargo fuzz`): small valid files ([`seeds`]) are mutated with format-aware operators
 //! ([`mutate`]: bit flips, truncation at every length of the header, header fields replaced by
 //! extremes, dimensions up to 2^31, wrong channel counts, NaN / infinity / negative values,
-//! broken JSON) and handed to the loaders the commands use. The harness ([`run`]) counts
+//! broken JSON, glTF containers, sizes and binary data) and handed to the loaders the commands
+//! use. The harness ([`run`]) counts
 //! panics (caught, with the first messages kept), errors that are not one line naming the file,
 //! and — through a [`MemoryWatch`] the binary provides — the most memory a case allocated.
 //!
@@ -13,6 +14,7 @@
 //! Architecture invariant: reads files only through the library crates' own loaders; never
 //! wgpu.
 
+pub mod model;
 pub mod mutate;
 pub mod seeds;
 
@@ -42,6 +44,10 @@ pub enum Format {
     Exr,
     /// JSON.
     Json,
+    /// glTF 2.0 JSON (`.gltf`, its buffer embedded as a data URI).
+    Gltf,
+    /// Binary glTF 2.0 (`.glb`).
+    Glb,
 }
 
 /// Loads a file's bytes under a name: `Err` is the loader's message.

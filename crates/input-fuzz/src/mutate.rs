@@ -3,7 +3,7 @@
 //! extremes: dimensions up to 2^31 and beyond, orientation and format lines (`.hdr`); data and
 //! display windows, channel lists (types, sampling, a missing colour channel), compression,
 //! offset tables and pixel values set to NaN, infinity or negative (`.exr`); numbers, types,
-//! nesting and structure (JSON).
+//! nesting and structure (JSON); glTF's container, sizes and binary data ([`crate::model`]).
 
 use crate::Format;
 use rand::Rng;
@@ -67,7 +67,9 @@ pub fn header_len(bytes: &[u8], format: Format) -> usize {
     match format {
         Format::Hdr => hdr_header_len(bytes),
         Format::Exr => exr_header_len(bytes).unwrap_or(bytes.len()).min(bytes.len()),
-        Format::Json => bytes.len().min(256),
+        Format::Json | Format::Gltf => bytes.len().min(256),
+        // the container's header and chunk header, and the start of the JSON
+        Format::Glb => bytes.len().min(96),
     }
 }
 
@@ -146,6 +148,8 @@ pub fn mutate(seed: &[u8], format: Format, rng: &mut impl Rng) -> Vec<u8> {
                 Format::Hdr => hdr(&mut bytes, rng),
                 Format::Exr => exr(&mut bytes, rng),
                 Format::Json => json(&mut bytes, rng),
+                Format::Gltf => crate::model::mutate(&mut bytes, false, rng),
+                Format::Glb => crate::model::mutate(&mut bytes, true, rng),
             }
         }
     }
@@ -340,7 +344,7 @@ fn join(parts: &[&[u8]]) -> Vec<u8> {
     parts.concat()
 }
 
-fn json(bytes: &mut Vec<u8>, rng: &mut impl Rng) {
+pub(crate) fn json(bytes: &mut Vec<u8>, rng: &mut impl Rng) {
     let text = bytes.clone();
     if text.is_empty() {
         bytes.extend(b"{\"lights\":[");

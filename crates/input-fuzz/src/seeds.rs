@@ -1,7 +1,9 @@
 //! Small valid files to mutate, made here so the harness needs nothing beside the repository:
 //! Radiance `.hdr` (flat and run-length encoded), OpenEXR (every compression the loader meets,
-//! RGB, RGBA and f16 channels), and `lights.json` as `extract` writes it; and the library
-//! targets that load them as the commands do.
+//! RGB, RGBA and f16 channels), `lights.json` as `extract` writes it, and glTF models (`.gltf`
+//! with an embedded buffer and `.glb`: built-in scenes as `Scene::to_gltf` writes them, and one
+//! written here with u8 and u16 indices, a strip, points, a node hierarchy and a camera); and the
+//! library targets that load them as the commands do.
 
 use crate::{FUZZ_MAX_PIXELS, Format, Target};
 use envmap_sphere::{EnvMap, LoadOptions, NegativePolicy};
@@ -124,9 +126,100 @@ pub fn lights_json() -> Vec<Vec<u8>> {
     out
 }
 
+/// A model written by hand: a cube (u16 indices) and its points under a TRS parent, through a
+/// matrix node; a quad as a u8 triangle strip; a material and a camera. Its document and buffer.
+fn handmade() -> (serde_json::Value, Vec<u8>) {
+    let f32s = |v: &[[f32; 3]]| -> Vec<u8> { v.iter().flatten().flat_map(|f| f.to_le_bytes()).collect() };
+    let corners: Vec<[f32; 3]> =
+        (0..8).map(|k| [(k & 1) as f32 - 0.5, ((k >> 1) & 1) as f32 - 0.5, ((k >> 2) & 1) as f32 - 0.5]).collect();
+    let faces: [[u16; 4]; 6] = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    let cube: Vec<u16> = faces.iter().flat_map(|f| [f[0], f[1], f[2], f[0], f[2], f[3]]).collect();
+    let quad = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 1.0]];
+    let mut bin = f32s(&corners);
+    bin.extend(cube.iter().flat_map(|i| i.to_le_bytes()));
+    bin.extend(f32s(&quad));
+    bin.extend([0u8, 1, 2, 3]);
+    let doc = serde_json::json!({
+        "asset": {"version": "2.0", "generator": "input-fuzz"},
+        "scene": 0,
+        "scenes": [{"nodes": [0, 3]}],
+        "nodes": [
+            {"name": "parent", "translation": [0.0, 1.0, 0.0], "rotation": [0.0, 0.382_683_43, 0.0, 0.923_879_5],
+             "scale": [2.0, 2.0, 2.0], "children": [1, 2]},
+            {"name": "cube", "mesh": 0, "matrix": [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0,
+             0.5, 0.25, 0.0, 1.0]},
+            {"name": "quad", "mesh": 1},
+            {"name": "camera", "camera": 0, "translation": [0.0, 1.5, 6.0]}
+        ],
+        "meshes": [
+            {"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0, "mode": 4},
+                            {"attributes": {"POSITION": 0}, "mode": 0}]},
+            {"primitives": [{"attributes": {"POSITION": 2}, "indices": 3, "mode": 5}]}
+        ],
+        "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.6, 0.4, 1.0]}, "doubleSided": true}],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.01, "aspectRatio": 1.333}}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 8, "type": "VEC3",
+             "min": [-0.5, -0.5, -0.5], "max": [0.5, 0.5, 0.5]},
+            {"bufferView": 1, "componentType": 5123, "count": 36, "type": "SCALAR"},
+            {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC3",
+             "min": [0.0, 0.0, 0.0], "max": [1.0, 0.0, 1.0]},
+            {"bufferView": 3, "componentType": 5121, "count": 4, "type": "SCALAR"}
+        ],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": 96, "target": 34962},
+            {"buffer": 0, "byteOffset": 96, "byteLength": 72, "target": 34963},
+            {"buffer": 0, "byteOffset": 168, "byteLength": 48, "target": 34962},
+            {"buffer": 0, "byteOffset": 216, "byteLength": 4, "target": 34963}
+        ],
+        "buffers": [{"byteLength": 220}]
+    });
+    (doc, bin)
+}
+
+/// The glTF seeds' documents and buffers: `three_boxes` and `column` as the export writes them,
+/// and [`handmade`].
+fn models() -> Vec<(serde_json::Value, Vec<u8>)> {
+    let mut out: Vec<_> = ["three_boxes", "column"]
+        .iter()
+        .filter_map(|n| scene::Scene::builtin(n).ok())
+        .map(|s| s.to_gltf(None))
+        .collect();
+    out.push(handmade());
+    out
+}
+
+/// `.gltf` files with their buffer embedded as a base64 data URI.
+#[must_use]
+pub fn gltf() -> Vec<Vec<u8>> {
+    models()
+        .into_iter()
+        .filter_map(|(mut doc, bin)| {
+            doc["buffers"][0]["uri"] = format!("{}{}", crate::model::DATA_URI, base64::encode(&bin)).into();
+            serde_json::to_vec(&doc).ok()
+        })
+        .collect()
+}
+
+/// `.glb` files: the same models in a binary container.
+#[must_use]
+pub fn glb() -> Vec<Vec<u8>> {
+    models()
+        .into_iter()
+        .filter_map(|(doc, bin)| Some(crate::model::glb(&serde_json::to_vec(&doc).ok()?, &bin)))
+        .collect()
+}
+
+/// The glTF import's options when fuzzed: a small camera and a million triangles at most, so a
+/// case that claims the most allowed stays within [`crate::CASE_ALLOCATION_LIMIT`].
+#[must_use]
+pub fn gltf_options() -> scene::import::GltfOptions {
+    scene::import::GltfOptions { size: (64, 48), max_triangles: 1 << 20, ..scene::import::GltfOptions::default() }
+}
+
 /// The loaders the commands use, on the seeds above: maps (`info`, `extract`, `--envmap`, the
 /// `ambient.exr` beside a `lights.json`, read signed), images (`compare`) and `lights.json`
-/// (`render --lights`).
+/// (`render --lights`), models (every command's scene or `--object` path).
 #[must_use]
 pub fn library_targets() -> Vec<Target> {
     let options = LoadOptions { max_pixels: FUZZ_MAX_PIXELS, ..LoadOptions::default() };
@@ -138,6 +231,9 @@ pub fn library_targets() -> Vec<Target> {
     };
     let image = move |bytes: &[u8], path: &std::path::Path| {
         envmap_sphere::load_rgb_image_from_bytes(bytes, path, &options).map(|_| ()).map_err(|e| e.to_string())
+    };
+    let model = |bytes: &[u8], path: &std::path::Path| {
+        scene::import::load_gltf_from_bytes(bytes, path, &gltf_options()).map(|_| ()).map_err(|e| e.to_string())
     };
     let (hdr, exr) = (hdr(), exr());
     vec![
@@ -173,5 +269,7 @@ pub fn library_targets() -> Vec<Target> {
                 light_extract::output::parse_lights_json(bytes, path).map(|_| ()).map_err(|e| e.to_string())
             }),
         },
+        Target { name: "model.gltf", extension: "gltf", format: Format::Gltf, seeds: gltf(), run: Box::new(model) },
+        Target { name: "model.glb", extension: "glb", format: Format::Glb, seeds: glb(), run: Box::new(model) },
     ]
 }

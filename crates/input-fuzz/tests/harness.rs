@@ -21,7 +21,13 @@ fn every_seed_loads_with_the_loaders_the_commands_use() {
 #[test]
 fn mutations_never_panic_and_change_the_file() {
     let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(3);
-    let sets = [(Format::Hdr, seeds::hdr()), (Format::Exr, seeds::exr()), (Format::Json, seeds::lights_json())];
+    let sets = [
+        (Format::Hdr, seeds::hdr()),
+        (Format::Exr, seeds::exr()),
+        (Format::Json, seeds::lights_json()),
+        (Format::Gltf, seeds::gltf()),
+        (Format::Glb, seeds::glb()),
+    ];
     for (format, seeds) in sets {
         let mut changed = 0;
         for k in 0..20_000 {

@@ -121,14 +121,31 @@ pub fn load_gltf(path: &Path, options: &GltfOptions) -> Result<GltfImport, GltfE
         });
     }
     let bytes = std::fs::read(path).map_err(io)?;
+    load_gltf_from_bytes(&bytes, path, options)
+}
+
+/// Imports `bytes` as the file `path` (`.gltf` or `.glb`): external buffers are looked for
+/// beside `path`, and every message names it. What [`load_gltf`] does once it has read the file;
+/// a fuzzer's or an embedder's way in.
+///
+/// # Errors
+/// As [`load_gltf`].
+pub fn load_gltf_from_bytes(bytes: &[u8], path: &Path, options: &GltfOptions) -> Result<GltfImport, GltfError> {
+    if bytes.len() as u64 > MAX_FILE_BYTES {
+        return Err(GltfError::Malformed {
+            path: path.to_path_buf(),
+            reason: format!("{} bytes, more than the {MAX_FILE_BYTES} a model may have", bytes.len()),
+        });
+    }
     let invalid = |e: gltf::Error| GltfError::Invalid { path: path.to_path_buf(), reason: e.to_string() };
     let compressed = |ext: &str| GltfError::Unsupported {
         path: path.to_path_buf(),
         extension: ext.to_string(),
         hint: "decompress it first, e.g. `gltf-transform copy in.glb out.glb` (glTF-Transform writes plain accessors)",
     };
+    precheck(bytes).map_err(|reason| GltfError::Malformed { path: path.to_path_buf(), reason })?;
     // the reader refuses a required extension it does not know; say which and what to do
-    let gltf::Gltf { document, blob } = gltf::Gltf::from_slice(&bytes).map_err(|e| {
+    let gltf::Gltf { document, blob } = gltf::Gltf::from_slice(bytes).map_err(|e| {
         let reason = e.to_string();
         COMPRESSION.iter().find(|c| reason.contains(*c)).map_or_else(|| invalid(e), |c| compressed(c))
     })?;
@@ -150,6 +167,65 @@ pub fn load_gltf(path: &Path, options: &GltfOptions) -> Result<GltfImport, GltfE
     }
     let buffers = gltf::import_buffers(&document, path.parent(), blob).map_err(invalid)?;
     Importer { path, options, buffers: &buffers, warnings: BTreeSet::new(), degenerate: 0, skipped: 0 }.run(&document)
+}
+
+/// What the `gltf` crate (1.4) panics on instead of refusing, found by `cargo xtask fuzz`: a GLB
+/// header whose length is under its own 12 bytes (an overflowing subtraction), and a primitive
+/// whose `POSITION` names an accessor past the document's (its validation indexes the array
+/// before checking the index). Checked here first; anything else is left to the reader.
+fn precheck(bytes: &[u8]) -> Result<(), String> {
+    let json = if bytes.starts_with(b"glTF") {
+        let Some(length) = bytes.get(8..12).and_then(|w| <[u8; 4]>::try_from(w).ok()).map(u32::from_le_bytes) else {
+            return Err(format!("a GLB header of {} bytes, under its 12 (truncated)", bytes.len()));
+        };
+        if length < 12 {
+            return Err(format!("the GLB header gives the file {length} bytes, under the header's own 12"));
+        }
+        let chunk = bytes.get(12..16).and_then(|w| <[u8; 4]>::try_from(w).ok()).map(u32::from_le_bytes);
+        match chunk.and_then(|n| bytes.get(20..20usize.checked_add(n as usize)?)) {
+            Some(json) => json,
+            None => return Ok(()),
+        }
+    } else {
+        bytes
+    };
+    // typed, ignoring the rest as the reader does: it skips a field it ignores without checking
+    // its numbers or UTF-8, so a full parse would refuse files the reader takes
+    let Ok(doc) = serde_json::from_slice::<Precheck>(json) else { return Ok(()) };
+    let accessors = doc.accessors.len();
+    for (m, mesh) in doc.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            for (name, index) in primitive.attributes.iter().chain(primitive.targets.iter().flatten().flatten()) {
+                if let Some(k) = index.as_u64().filter(|&k| k >= accessors as u64) {
+                    return Err(format!("mesh {m} primitive {p}: {name} is accessor {k}, past the file's {accessors}"));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// What [`precheck`] reads of a document.
+#[derive(serde::Deserialize)]
+struct Precheck {
+    #[serde(default)]
+    accessors: Vec<serde::de::IgnoredAny>,
+    #[serde(default)]
+    meshes: Vec<PrecheckMesh>,
+}
+
+#[derive(serde::Deserialize)]
+struct PrecheckMesh {
+    #[serde(default)]
+    primitives: Vec<PrecheckPrimitive>,
+}
+
+#[derive(serde::Deserialize)]
+struct PrecheckPrimitive {
+    #[serde(default)]
+    attributes: std::collections::BTreeMap<String, Value>,
+    #[serde(default)]
+    targets: Option<Vec<std::collections::BTreeMap<String, Value>>>,
 }
 
 struct Importer<'a> {
@@ -285,10 +361,11 @@ impl Importer<'_> {
         let size = accessor.size();
         let stride = view.stride().unwrap_or(size);
         let count = accessor.count();
+        // an empty accessor still has to start inside its view: its data is sliced from there
         let need = if count == 0 {
-            Some(0)
+            Some(accessor.offset())
         } else {
-            (count - 1).checked_mul(stride).and_then(|n| n.checked_add(accessor.offset() + size))
+            (count - 1).checked_mul(stride).and_then(|n| n.checked_add(accessor.offset().checked_add(size)?))
         };
         if stride < size || need.is_none_or(|n| n > data.len()) {
             return Err(self.malformed(format!(

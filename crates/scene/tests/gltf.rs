@@ -284,6 +284,27 @@ fn bad_files_are_errors_naming_the_file() {
     assert!(
         matches!(refused(&draco), GltfError::Unsupported { extension, .. } if extension == "KHR_draco_mesh_compression")
     );
+    // what the gltf crate itself panics on (found by `cargo xtask fuzz`): a GLB header whose
+    // length is under its own 12 bytes, a POSITION past the accessors
+    let mut short = full.clone();
+    short[8..12].copy_from_slice(&8u32.to_le_bytes());
+    let short_path = d.join("short.glb");
+    std::fs::write(&short_path, &short).expect("write");
+    assert!(refused(&short_path).to_string().contains("under the header's own 12"));
+    let position = write_gltf(&d, "position", &doc("").replace(r#""POSITION": 0"#, r#""POSITION": 99"#), &b);
+    assert!(refused(&position).to_string().contains("POSITION is accessor 99"));
+    // the same behind a field the reader ignores without parsing its number (nor its UTF-8)
+    let hidden = doc(r#", "unknown": [1e309, "\u00ff"]"#).replace(r#""POSITION": 0"#, r#""POSITION": 99"#);
+    let hidden = write_gltf(&d, "hidden", &hidden.replace("x.bin", "hidden.bin"), &b);
+    assert!(refused(&hidden).to_string().contains("POSITION is accessor 99"));
+    // an empty accessor that starts past its view
+    let empty = doc("").replace(
+        &format!(r#""componentType": 5123, "count": {}"#, idx.len()),
+        r#""componentType": 5123, "count": 0, "byteOffset": 4000"#,
+    );
+    assert!(empty.contains("\"byteOffset\": 4000"));
+    let empty = write_gltf(&d, "empty", &empty.replace("x.bin", "empty.bin"), &b);
+    assert!(refused(&empty).to_string().contains("runs past"));
     // more triangles than the limit: refused before the indices are read
     let path = write_gltf(&d, "x", &doc(""), &b);
     let e = load_gltf(&path, &GltfOptions { max_triangles: 11, ..GltfOptions::default() }).expect_err("over the limit");
