@@ -56,6 +56,10 @@ pub struct RenderArgs {
     /// Stop after the pass that ends past this many seconds.
     #[arg(long)]
     pub time_budget: Option<f64>,
+    /// BVH build preset, fastest build first: fastest, very-fast, fast, medium, slow, very-slow
+    /// (the fastest traversal; at millions of triangles the build is the longest start-up step).
+    #[arg(long, default_value = "very-slow")]
+    pub bvh: String,
     /// Image size WIDTHxHEIGHT instead of the scene's camera.
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
@@ -119,10 +123,16 @@ pub(crate) fn run(args: &RenderArgs) -> Result<(), String> {
         ground: args.ground,
         ..scene::import::GltfOptions::default()
     };
+    let quality = ref_tracer::BvhQuality::parse(&args.bvh).ok_or_else(|| {
+        let names: Vec<&str> = ref_tracer::BvhQuality::ALL.iter().map(|q| q.name()).collect();
+        format!("--bvh {}: one of {}", args.bvh, names.join(", "))
+    })?;
+    let t = std::time::Instant::now();
     let (mut scene, warnings) = Scene::open(&args.scene, &options).map_err(|e| e.to_string())?;
     for w in warnings {
         eprintln!("warning: {}: {w}", args.scene);
     }
+    let load_s = t.elapsed().as_secs_f64();
     if let Some((w, h)) = args.size {
         scene.camera.width = w;
         scene.camera.height = h;
@@ -172,7 +182,12 @@ pub(crate) fn run(args: &RenderArgs) -> Result<(), String> {
         _ if complete => Some(EnvLight::complete(&map)),
         _ => Some(EnvLight::new(&map)),
     };
-    let bvh = SceneBvh::new(&scene);
+    // progress only once every argument is known good: a refusal stays one line
+    let triangles: usize = scene.objects.iter().map(|o| o.mesh.indices.len()).sum();
+    eprintln!("{}: {} objects, {triangles} triangles, loaded in {load_s:.2} s", args.scene, scene.objects.len());
+    let t = std::time::Instant::now();
+    let bvh = SceneBvh::with_quality(&scene, quality);
+    eprintln!("BVH ({}) built in {:.2} s", quality.name(), t.elapsed().as_secs_f64());
     let bar = indicatif::ProgressBar::new(u64::from(args.spp));
     bar.set_style(
         indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} spp, {elapsed} (eta {eta})")

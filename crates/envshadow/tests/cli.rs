@@ -44,6 +44,12 @@ fn bad_input_exits_one_with_one_line_naming_the_file() {
             assert!(out.stdout.is_empty(), "{args:?}");
         }
     }
+    // a BVH preset that is not one: refused before anything is loaded, naming the presets
+    let bad = envshadow(&["render", "--scene", "room", "--bvh", "quick", "--spp", "1", "--size", "8x6", "--out", out]);
+    assert_eq!(bad.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(err.contains("quick") && err.contains("very-slow"), "{err}");
 }
 
 #[test]

@@ -34,7 +34,7 @@ mod render;
 pub mod sampler;
 pub mod visibility;
 
-pub use bvh::{SceneBvh, SurfacePoint};
+pub use bvh::{BvhQuality, SceneBvh, SurfacePoint};
 pub use emitters::Emitters;
 pub use integrator::{AmbientMap, EnvLight, Integrator, LightSet, Strategy};
 pub use render::{Render, RenderSettings, render};
