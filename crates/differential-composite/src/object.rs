@@ -73,12 +73,10 @@ impl SyntheticObject {
         if !scene::is_model(spec) {
             return Ok((Self::builtin(spec, centre)?, Vec::new()));
         }
-        let import = scene::import::load_gltf(std::path::Path::new(spec), &scene::import::GltfOptions::default())
-            .map_err(scene::SceneError::from)?;
+        let (model, mut all) = scene::Scene::open(spec, &scene::import::GltfOptions::default())?;
         let name =
             std::path::Path::new(spec).file_stem().map_or_else(|| spec.to_string(), |s| s.to_string_lossy().into());
-        let (object, mut warnings) = Self::from_scene(&name, &import.scene, centre, model_size)?;
-        let mut all = import.warnings;
+        let (object, mut warnings) = Self::from_scene(&name, &model, centre, model_size)?;
         all.append(&mut warnings);
         Ok((object, all))
     }
@@ -142,9 +140,8 @@ impl SyntheticObject {
         if !scene.point_lights.is_empty() {
             warnings.push(format!("its {} point lights are not composited", scene.point_lights.len()));
         }
-        let bounds_centre =
-            mesh.positions.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
-        let centre = 0.5 * (bounds_centre.0 + bounds_centre.1);
+        // the fitted bounding box's centre: half its height above the cube's floor
+        let centre = target + Vec3::new(0.0, 0.5 * scale * (hi.y - lo.y), 0.0);
         Ok((
             Self {
                 name: name.to_string(),

@@ -13,29 +13,11 @@ use std::ops::Range;
 /// The URI prefix of a buffer embedded in a `.gltf`.
 pub const DATA_URI: &str = "data:application/octet-stream;base64,";
 
-/// A GLB container around `json` and `bin`: the 12-byte header and two chunks, each padded to 4
-/// bytes (spaces and zeros), with every length as the format asks (so damage inside a chunk
-/// reaches the reader behind the container). `bin` empty: no BIN chunk.
+/// A GLB container around `json` and `bin` with every length right ([`scene::glb_bytes`]), so
+/// damage inside a chunk reaches the reader behind the container.
 #[must_use]
 pub fn glb(json: &[u8], bin: &[u8]) -> Vec<u8> {
-    let pad = |n: usize| n.next_multiple_of(4);
-    let total = 12 + 8 + pad(json.len()) + if bin.is_empty() { 0 } else { 8 + pad(bin.len()) };
-    let u32le = |n: usize| u32::try_from(n).unwrap_or(u32::MAX).to_le_bytes();
-    let mut out = Vec::with_capacity(total);
-    out.extend_from_slice(b"glTF");
-    out.extend_from_slice(&2u32.to_le_bytes());
-    out.extend_from_slice(&u32le(total));
-    out.extend_from_slice(&u32le(pad(json.len())));
-    out.extend_from_slice(b"JSON");
-    out.extend_from_slice(json);
-    out.resize(20 + pad(json.len()), b' ');
-    if !bin.is_empty() {
-        out.extend_from_slice(&u32le(pad(bin.len())));
-        out.extend_from_slice(b"BIN\0");
-        out.extend_from_slice(bin);
-        out.resize(total, 0);
-    }
-    out
+    scene::glb_bytes(json, bin).unwrap_or_default()
 }
 
 /// A GLB's JSON and BIN chunks (BIN empty when there is none), when its container parses.

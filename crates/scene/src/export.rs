@@ -126,7 +126,7 @@ impl Scene {
         let glb = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("glb"));
         if glb {
             let (doc, bin) = self.to_gltf(None);
-            let bytes = glb_bytes(&doc, bin)
+            let bytes = glb_bytes(&serde_json::to_vec(&doc).unwrap_or_default(), &bin)
                 .ok_or_else(|| io(path)(std::io::Error::other("more than the 4 GiB a .glb can hold; write a .gltf")))?;
             return std::fs::write(path, bytes).map_err(io(path));
         }
@@ -139,24 +139,26 @@ impl Scene {
     }
 }
 
-/// A GLB container: the 12-byte header, the JSON chunk padded with spaces, the BIN chunk padded
-/// with zeros (both to 4 bytes, as the format asks); `None` past the format's 4 GiB.
-fn glb_bytes(doc: &Value, mut bin: Vec<u8>) -> Option<Vec<u8>> {
-    let mut text = serde_json::to_vec(doc).unwrap_or_default();
-    text.resize(text.len().next_multiple_of(4), b' ');
-    bin.resize(bin.len().next_multiple_of(4), 0);
-    let total = 12 + 8 + text.len() + 8 + bin.len();
+/// A GLB container around `json` and `bin`: the 12-byte header, the JSON chunk padded with
+/// spaces, the BIN chunk padded with zeros (both to 4 bytes, as the format asks); `None` past the
+/// format's 4 GiB. The bytes need not be valid (a fuzzer wraps damaged JSON in a sound container).
+#[must_use]
+pub fn glb_bytes(json: &[u8], bin: &[u8]) -> Option<Vec<u8>> {
+    let (json_len, bin_len) = (json.len().next_multiple_of(4), bin.len().next_multiple_of(4));
+    let total = 12 + 8 + json_len + 8 + bin_len;
     u32::try_from(total).ok()?;
-    let mut out = Vec::with_capacity(total);
     let u32le = |n: usize| u32::try_from(n).unwrap_or(u32::MAX).to_le_bytes();
+    let mut out = Vec::with_capacity(total);
     out.extend_from_slice(b"glTF");
     out.extend_from_slice(&2u32.to_le_bytes());
     out.extend_from_slice(&u32le(total));
-    out.extend_from_slice(&u32le(text.len()));
+    out.extend_from_slice(&u32le(json_len));
     out.extend_from_slice(b"JSON");
-    out.extend_from_slice(&text);
-    out.extend_from_slice(&u32le(bin.len()));
+    out.extend_from_slice(json);
+    out.resize(20 + json_len, b' ');
+    out.extend_from_slice(&u32le(bin_len));
     out.extend_from_slice(b"BIN\0");
-    out.extend_from_slice(&bin);
+    out.extend_from_slice(bin);
+    out.resize(total, 0);
     Some(out)
 }

@@ -22,6 +22,7 @@ mod visibility;
 
 pub use builtin::BUILTIN_SCENES;
 pub use camera::{Camera, CameraRays};
+pub use export::glb_bytes;
 pub use light::{DistantLight, LightShape, PointLight, cone_cosine_integral};
 pub use material::{Ggx, Material};
 pub use mesh::{Mesh, normal_matrix};

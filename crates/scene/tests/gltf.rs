@@ -67,24 +67,9 @@ fn write_gltf(d: &Path, name: &str, json: &str, bin: &[u8]) -> PathBuf {
     p
 }
 
-/// A GLB of `json` and `bin`.
+/// A GLB of `json` and `bin`, through the writer the export uses.
 fn glb(json: &str, bin: &[u8]) -> Vec<u8> {
-    let mut j = json.as_bytes().to_vec();
-    while !j.len().is_multiple_of(4) {
-        j.push(b' ');
-    }
-    let total = 12 + 8 + j.len() + 8 + bin.len();
-    let mut out = Vec::new();
-    out.extend(b"glTF");
-    out.extend(2u32.to_le_bytes());
-    out.extend((total as u32).to_le_bytes());
-    out.extend((j.len() as u32).to_le_bytes());
-    out.extend(b"JSON");
-    out.extend(&j);
-    out.extend((bin.len() as u32).to_le_bytes());
-    out.extend(b"BIN\0");
-    out.extend(bin);
-    out
+    scene::glb_bytes(json.as_bytes(), bin).expect("under 4 GiB")
 }
 
 fn cube() -> (Vec<Vec3>, Vec<u16>) {
