@@ -28,7 +28,13 @@ impl ObjectBvh {
     pub fn new(object: &SyntheticObject, shadow_mesh: &scene::Mesh, camera: scene::Camera, build: &BuildRays) -> Self {
         let one = |mesh: &scene::Mesh| {
             let o = scene::Object { mesh: mesh.clone(), ..object.to_object() };
-            build(&scene::Scene { name: object.name.clone(), objects: vec![o], camera, point_lights: Vec::new() })
+            build(&scene::Scene {
+                name: object.name.clone(),
+                objects: vec![o],
+                camera,
+                point_lights: Vec::new(),
+                textures: Vec::new(),
+            })
         };
         Self { seen: one(&object.mesh), caster: one(shadow_mesh) }
     }

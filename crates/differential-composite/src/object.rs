@@ -187,7 +187,7 @@ impl SyntheticObject {
         scene::Object {
             name: self.name.clone(),
             mesh: self.mesh.clone(),
-            material: scene::Material { albedo: self.albedo, specular: None },
+            material: scene::Material::rgb(self.albedo, None),
         }
     }
 }
@@ -221,7 +221,7 @@ pub fn uv_sphere(centre: Vec3, radius: f32, slices: u32, stacks: u32) -> Mesh {
             indices.push([a, c, d]);
         }
     }
-    Mesh { positions: dirs.iter().map(|d| centre + *d * radius).collect(), normals: Some(dirs), indices }
+    Mesh { positions: dirs.iter().map(|d| centre + *d * radius).collect(), normals: Some(dirs), indices, uvs: None }
 }
 
 #[cfg(test)]

@@ -325,7 +325,7 @@ fn composite_takes_a_model_fitted_where_the_builtin_would_stand() {
     model.objects = vec![scene::Object {
         name: "crate".into(),
         mesh: scene::Mesh::cuboid(glam::Vec3::splat(-7.0), glam::Vec3::splat(-4.0)),
-        material: scene::Material { albedo: glam::Vec3::new(0.7, 0.7, 0.65), specular: None },
+        material: scene::Material::rgb(glam::Vec3::new(0.7, 0.7, 0.65), None),
     }];
     let glb = dir.join("crate.glb");
     model.write_gltf(&glb).expect("write crate.glb");

@@ -10,6 +10,14 @@ struct Material {
     albedo: vec4<f32>,
     // rgb F0; a = roughness
     f0_roughness: vec4<f32>,
+    // rgb emitted radiance
+    emission: vec4<f32>,
+    // glTF's factors where the material is textured (`scene::Maps`): rgb base colour, a metallic
+    base_metallic: vec4<f32>,
+    // x roughness factor, y 1 where textured
+    pbr: vec4<f32>,
+    // base colour, metallic-roughness and emissive texture (0xffffffff: none)
+    maps: vec4<u32>,
 }
 
 fn ggx_d(noh: f32, alpha: f32) -> f32 {

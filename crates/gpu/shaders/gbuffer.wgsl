@@ -1,5 +1,7 @@
 // G-buffer pass: world position (w = object index, -1 where nothing was hit), shading normal
-// and geometric normal, both facing the camera as `ref-tracer` orients them.
+// and geometric normal, both facing the camera as `ref-tracer` orients them, their w the
+// texture coordinates u and v. The back faces of one-sided materials are culled, as
+// `ref-tracer`'s camera rays pass them.
 
 struct Camera {
     view_proj: mat4x4<f32>,
@@ -13,6 +15,8 @@ struct VsIn {
     @location(1) normal: vec3<f32>,
     @location(2) geometric_normal: vec3<f32>,
     @location(3) object: u32,
+    @location(4) uv: vec2<f32>,
+    @location(5) cull: u32,
 }
 
 struct VsOut {
@@ -22,6 +26,8 @@ struct VsOut {
     @location(1) normal: vec3<f32>,
     @location(2) @interpolate(flat) geometric_normal: vec3<f32>,
     @location(3) @interpolate(flat) object: u32,
+    @location(4) uv: vec2<f32>,
+    @location(5) @interpolate(flat) cull: u32,
 }
 
 @vertex
@@ -32,6 +38,8 @@ fn vs(v: VsIn) -> VsOut {
     out.normal = v.normal;
     out.geometric_normal = v.geometric_normal;
     out.object = v.object;
+    out.uv = v.uv;
+    out.cull = v.cull;
     return out;
 }
 
@@ -41,7 +49,7 @@ struct GBufferOut {
     @location(2) geometric_normal: vec4<f32>,
 }
 
-fn surface(world: vec3<f32>, normal: vec3<f32>, geometric_normal: vec3<f32>, object: u32) -> GBufferOut {
+fn surface(world: vec3<f32>, normal: vec3<f32>, geometric_normal: vec3<f32>, object: u32, uv: vec2<f32>) -> GBufferOut {
     var ng = geometric_normal;
     // toward the viewer: to the eye, or (w = 0) along an orthographic view's axis
     if dot(ng, camera.eye.xyz - world * camera.eye.w) < 0.0 {
@@ -55,14 +63,22 @@ fn surface(world: vec3<f32>, normal: vec3<f32>, geometric_normal: vec3<f32>, obj
     }
     var out: GBufferOut;
     out.position = vec4<f32>(world, f32(object));
-    out.normal = vec4<f32>(ns, 0.0);
-    out.geometric_normal = vec4<f32>(ng, 0.0);
+    out.normal = vec4<f32>(ns, uv.x);
+    out.geometric_normal = vec4<f32>(ng, uv.y);
     return out;
+}
+
+// The geometric normal, as uploaded, faces the triangle's front (counter-clockwise) side.
+fn culled(in: VsOut) -> bool {
+    return in.cull != 0u && dot(in.geometric_normal, camera.eye.xyz - in.world * camera.eye.w) < 0.0;
 }
 
 @fragment
 fn fs(in: VsOut) -> GBufferOut {
-    return surface(in.world, in.normal, in.geometric_normal, in.object);
+    if culled(in) {
+        discard;
+    }
+    return surface(in.world, in.normal, in.geometric_normal, in.object, in.uv);
 }
 
 // Within WebGPU's default limits (32 colour bytes a sample) the G-buffer takes two passes over
@@ -76,11 +92,17 @@ struct SurfaceOut {
 
 @fragment
 fn fs_surface(in: VsOut) -> SurfaceOut {
-    let g = surface(in.world, in.normal, in.geometric_normal, in.object);
+    if culled(in) {
+        discard;
+    }
+    let g = surface(in.world, in.normal, in.geometric_normal, in.object, in.uv);
     return SurfaceOut(g.position, g.normal);
 }
 
 @fragment
 fn fs_geometric(in: VsOut) -> @location(0) vec4<f32> {
-    return surface(in.world, in.normal, in.geometric_normal, in.object).geometric_normal;
+    if culled(in) {
+        discard;
+    }
+    return surface(in.world, in.normal, in.geometric_normal, in.object, in.uv).geometric_normal;
 }

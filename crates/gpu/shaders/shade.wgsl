@@ -19,7 +19,7 @@ struct Params {
     right: vec4<f32>,
     down: vec4<f32>,
     corner: vec4<f32>,
-    // x light count, y 1 = ambient on, z background width, w background height (0: black)
+    // x light count, y bit 0 ambient on, bit 1 emission on, z background width, w background height (0: black)
     counts: vec4<u32>,
     // the prefiltered ambient of the specular lobe: x width, y height, z levels (0: none),
     // w side of the directional-albedo table
@@ -40,6 +40,85 @@ struct Params {
 // directional albedo as (F0 scale, bias) over (cos theta_o, roughness)
 @group(0) @binding(8) var prefiltered: texture_2d_array<f32>;
 @group(0) @binding(9) var dfg: texture_2d<f32>;
+// `gpu::geometry`'s texel words: per texture a header (first texel, width, height, wrap u |
+// wrap v << 2 | nearest << 4), then RGBA8 texels
+@group(0) @binding(10) var<storage, read> texels: array<u32>;
+
+const NO_TEXTURE: u32 = 0xffffffffu;
+const MIN_ROUGHNESS: f32 = 0.0316;
+
+fn srgb_to_linear(c: f32) -> f32 {
+    return select(pow((c + 0.055) / 1.055, 2.4), c / 12.92, c <= 0.04045);
+}
+
+// `scene::Wrap::texel`: 0 repeat, 1 clamp, 2 mirrored repeat.
+fn wrap_texel(i: i32, n: i32, mode: u32) -> u32 {
+    if mode == 1u {
+        return u32(clamp(i, 0, n - 1));
+    }
+    if mode == 2u {
+        let k = ((i % (2 * n)) + 2 * n) % (2 * n);
+        return u32(select(2 * n - 1 - k, k, k < n));
+    }
+    return u32(((i % n) + n) % n);
+}
+
+fn texel(first: u32, w: u32, x: u32, y: u32, srgb: bool) -> vec4<f32> {
+    let c = unpack4x8unorm(texels[first + y * w + x]);
+    if srgb {
+        return vec4<f32>(srgb_to_linear(c.r), srgb_to_linear(c.g), srgb_to_linear(c.b), c.a);
+    }
+    return c;
+}
+
+// `scene::Texture::sample`: full resolution, nearest or bilinear, wrapped; white for none.
+fn sample_texture(t: u32, uv_in: vec2<f32>, srgb: bool) -> vec4<f32> {
+    if t == NO_TEXTURE || 4u * t + 3u >= arrayLength(&texels) {
+        return vec4<f32>(1.0);
+    }
+    let first = texels[4u * t];
+    let size = vec2<u32>(texels[4u * t + 1u], texels[4u * t + 2u]);
+    let mode = texels[4u * t + 3u];
+    if size.x == 0u || size.y == 0u {
+        return vec4<f32>(1.0);
+    }
+    let n = vec2<i32>(size);
+    let wu = mode & 3u;
+    let wv = (mode >> 2u) & 3u;
+    // clamped where a float no longer tells texels apart, so the conversion to i32 is exact
+    let p = clamp(uv_in * vec2<f32>(size), vec2<f32>(-1e9), vec2<f32>(1e9));
+    if (mode & 16u) != 0u {
+        let q = vec2<i32>(floor(p));
+        return texel(first, size.x, wrap_texel(q.x, n.x, wu), wrap_texel(q.y, n.y, wv), srgb);
+    }
+    let c = p - vec2<f32>(0.5);
+    let c0 = floor(c);
+    let f = c - c0;
+    let q = vec2<i32>(c0);
+    let x0 = wrap_texel(q.x, n.x, wu);
+    let x1 = wrap_texel(q.x + 1, n.x, wu);
+    let y0 = wrap_texel(q.y, n.y, wv);
+    let y1 = wrap_texel(q.y + 1, n.y, wv);
+    let top = mix(texel(first, size.x, x0, y0, srgb), texel(first, size.x, x1, y0, srgb), f.x);
+    let bottom = mix(texel(first, size.x, x0, y1, srgb), texel(first, size.x, x1, y1, srgb), f.x);
+    return mix(top, bottom, f.y);
+}
+
+// `scene::Material::at`: a textured material resolved at `uv` into a uniform one.
+fn material_at(m: Material, uv: vec2<f32>) -> Material {
+    if m.pbr.y < 0.5 {
+        return m;
+    }
+    var out = m;
+    let base = clamp(m.base_metallic.rgb * sample_texture(m.maps.x, uv, true).rgb, vec3<f32>(0.0), vec3<f32>(1.0));
+    let mr = sample_texture(m.maps.y, uv, false);
+    let metallic = clamp(m.base_metallic.a * mr.b, 0.0, 1.0);
+    let roughness = max(clamp(m.pbr.x * mr.g, 0.0, 1.0), MIN_ROUGHNESS);
+    out.albedo = vec4<f32>(base * (1.0 - metallic), 1.0);
+    out.f0_roughness = vec4<f32>(mix(vec3<f32>(0.04), base, metallic), roughness);
+    out.emission = vec4<f32>(m.emission.rgb * sample_texture(m.maps.z, uv, true).rgb, 0.0);
+    return out;
+}
 
 // Bilinear lat-long lookup in layer `layer` of `t` (`size` texels), wrapping in u and
 // clamping in v (`EnvMap::lookup`).
@@ -177,12 +256,16 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
         let dir = normalize(params.corner.xyz + params.right.xyz * frag.x + params.down.xyz * frag.y);
         return vec4<f32>(background_radiance(dir), 1.0);
     }
-    let m = materials[u32(p.w)];
-    let n = textureLoad(g_normal, pixel, 0).xyz;
-    let ng = textureLoad(g_geometric_normal, pixel, 0).xyz;
+    let n4 = textureLoad(g_normal, pixel, 0);
+    let ng4 = textureLoad(g_geometric_normal, pixel, 0);
+    let m = material_at(materials[u32(p.w)], vec2<f32>(n4.w, ng4.w));
+    let n = n4.xyz;
+    let ng = ng4.xyz;
     // toward the viewer: to the eye, or (w = 0) along an orthographic view's axis
     let wo = normalize(params.eye.xyz - p.xyz * params.eye.w);
-    var l = vec3<f32>(0.0);
+    // the G-buffer holds the sides a camera sees: a one-sided material's front, either side
+    // of a double-sided one
+    var l = select(vec3<f32>(0.0), m.emission.rgb, (params.counts.y & 2u) != 0u);
     for (var k = 0u; k < params.counts.x; k++) {
         let light = lights[k];
         var wi = light.position_or_direction.xyz;
@@ -209,7 +292,7 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
         let v = textureLoad(visibility, pixel, k, 0).r;
         l += eval_brdf(m, n, wo, wi) * max(dot(n, wi), 0.0) * e * v;
     }
-    if params.counts.y == 1u {
+    if (params.counts.y & 1u) != 0u {
         // unclamped, as `ref-tracer`: a residual's irradiance is signed
         l += m.albedo.rgb * diffuse_weight(m) * sh9_irradiance(params.sh, n) / PI;
     }

@@ -125,7 +125,7 @@ impl GBufferPass {
                 module,
                 entry_point: Some(vs),
                 compilation_options: Default::default(),
-                buffers: &[Some(SceneGeometry::LAYOUT)],
+                buffers: &[Some(SceneGeometry::LAYOUT), Some(SceneGeometry::SURFACE_LAYOUT)],
             },
             primitive: wgpu::PrimitiveState::default(),
             depth_stencil: Some(wgpu::DepthStencilState {
@@ -271,6 +271,7 @@ impl GBufferPass {
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &bind, &[]);
             pass.set_vertex_buffer(0, geometry.vertices.slice(..));
+            pass.set_vertex_buffer(1, geometry.surface.slice(..));
             pass.draw(0..geometry.vertex_count, 0..1);
         };
         match second {

@@ -15,19 +15,98 @@ struct ShadedVertex {
     object: u32,
 }
 
-/// Material as the shaders read it (`crates/gpu/shaders/brdf.wgsl`).
+/// What the G-buffer reads of a vertex beside its position and normals (a second vertex
+/// buffer, so the placed one stays within a buffer's default 256 MiB at 2 M triangles):
+/// texture coordinates and whether the back face is culled.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct SurfaceVertex {
+    uv: [f32; 2],
+    /// 1: one-sided (back faces culled), 0: double-sided
+    cull: u32,
+}
+
+/// "No texture" in [`GpuMaterial::maps`].
+const NO_TEXTURE: u32 = u32::MAX;
+
+/// Material as the shaders read it (`crates/gpu/shaders/brdf.wgsl`): the uniform material,
+/// and where it has [`scene::Maps`] the factors and textures `material_at` resolves it from
+/// (`crates/gpu/shaders/shade.wgsl`, as [`scene::Material::at`]).
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 pub(crate) struct GpuMaterial {
     albedo: [f32; 4],
     f0_roughness: [f32; 4],
+    emission: [f32; 4],
+    /// rgb base colour factor, a metallic factor
+    base_metallic: [f32; 4],
+    /// x roughness factor, y 1 where textured
+    pbr: [f32; 4],
+    /// base colour, metallic-roughness and emissive texture (`NO_TEXTURE`: none)
+    maps: [u32; 4],
 }
 
 impl GpuMaterial {
     fn new(m: &scene::Material) -> Self {
         let (has, f0, r) = m.specular.map_or((0.0, Vec3::ZERO, 1.0), |g| (1.0, g.f0, g.roughness));
-        Self { albedo: [m.albedo.x, m.albedo.y, m.albedo.z, has], f0_roughness: [f0.x, f0.y, f0.z, r] }
+        let e = m.emission;
+        let mut out = Self {
+            albedo: [m.albedo.x, m.albedo.y, m.albedo.z, has],
+            f0_roughness: [f0.x, f0.y, f0.z, r],
+            emission: [e.x, e.y, e.z, 0.0],
+            base_metallic: [0.0; 4],
+            pbr: [0.0; 4],
+            maps: [NO_TEXTURE; 4],
+        };
+        if let Some(maps) = m.maps {
+            let b = maps.base_color;
+            out.base_metallic = [b.x, b.y, b.z, maps.metallic];
+            out.pbr = [maps.roughness, 1.0, 0.0, 0.0];
+            let t = |t: Option<u32>| t.unwrap_or(NO_TEXTURE);
+            out.maps = [t(maps.base_color_texture), t(maps.metallic_roughness_texture), t(maps.emissive_texture), 0];
+            out.emission = [maps.emissive.x, maps.emissive.y, maps.emissive.z, 0.0];
+        }
+        out
     }
+}
+
+/// The scene's textures as one storage buffer of words: per texture a header (first texel's
+/// word, width, height, wrap u | wrap v << 2 | nearest << 4), then every texture's RGBA8
+/// texels, row by row. Textures are halved until the whole fits `limit` bytes; the count of
+/// halvings comes back.
+fn texel_words(textures: &[scene::Texture], limit: u64) -> (Vec<u32>, u32) {
+    let mut textures: Vec<std::borrow::Cow<scene::Texture>> = textures.iter().map(std::borrow::Cow::Borrowed).collect();
+    let bytes = |t: &[std::borrow::Cow<scene::Texture>]| {
+        4 * (4 * t.len() as u64 + t.iter().map(|t| u64::from(t.width) * u64::from(t.height)).sum::<u64>())
+    };
+    let mut halvings = 0;
+    while bytes(&textures) > limit {
+        // the largest texture gives way first
+        let Some(k) = (0..textures.len()).max_by_key(|&k| u64::from(textures[k].width) * u64::from(textures[k].height))
+        else {
+            break;
+        };
+        if textures[k].width <= 1 && textures[k].height <= 1 {
+            break;
+        }
+        textures[k] = std::borrow::Cow::Owned(textures[k].halved());
+        halvings += 1;
+    }
+    let mut words = Vec::with_capacity((bytes(&textures) / 4) as usize + 1);
+    let mut next = 4 * textures.len() as u32;
+    for t in &textures {
+        let nearest = u32::from(t.filter == scene::Filter::Nearest);
+        words.extend([next, t.width, t.height, t.wrap[0].code() | t.wrap[1].code() << 2 | nearest << 4]);
+        next += t.width * t.height;
+    }
+    for t in &textures {
+        words.extend(t.texels.iter().map(|&c| u32::from_le_bytes(c)));
+    }
+    if words.is_empty() {
+        // storage bindings may not be empty
+        words.push(0);
+    }
+    (words, halvings)
 }
 
 /// A scene's triangles as the G-buffer pass draws them.
@@ -35,6 +114,13 @@ pub struct SceneGeometry {
     pub(crate) vertices: wgpu::Buffer,
     pub(crate) vertex_count: u32,
     pub(crate) materials: wgpu::Buffer,
+    /// texture coordinates and culling per vertex ([`SurfaceVertex`])
+    pub(crate) surface: wgpu::Buffer,
+    /// the textures ([`texel_words`])
+    pub(crate) texels: wgpu::Buffer,
+    /// How many times a texture was halved to fit the GPU's storage binding limit (0: every
+    /// texture at full size, as the reference tracer samples it).
+    pub texture_halvings: u32,
     /// Axis-aligned bounds of the scene, its objects where their transforms put them.
     pub bounds: (Vec3, Vec3),
     // per object: first vertex, vertex count, bounds in object space
@@ -58,6 +144,17 @@ fn check_count(gpu: &Gpu, vertices: usize, stride: u64) -> Result<(), GpuError> 
         return Err(GpuError::TooLarge { what: "vertex buffer bytes", size, limit });
     }
     Ok(())
+}
+
+/// Object `object`'s per-vertex texture coordinates and culling, three per triangle.
+fn surface_vertices(object: &scene::Object) -> Vec<SurfaceVertex> {
+    let mesh = &object.mesh;
+    let cull = u32::from(!object.material.double_sided);
+    mesh.indices
+        .iter()
+        .flatten()
+        .map(|&i| SurfaceVertex { uv: mesh.uvs.as_ref().map_or([0.0; 2], |uv| uv[i as usize].to_array()), cull })
+        .collect()
 }
 
 /// Object `k`'s G-buffer vertices (three per triangle) and their bounds.
@@ -102,6 +199,13 @@ impl SceneGeometry {
             objects.push((vertices.len() as u32, v.len() as u32, bounds));
             vertices.extend(v);
         }
+        let mut surface: Vec<SurfaceVertex> = scene.objects.iter().flat_map(surface_vertices).collect();
+        if surface.is_empty() {
+            // as the vertices: a buffer slice may not be empty
+            surface.push(SurfaceVertex { uv: [0.0; 2], cull: 0 });
+        }
+        let limit = gpu.limits.max_storage_buffer_binding_size.min(gpu.limits.max_buffer_size);
+        let (texels, texture_halvings) = texel_words(&scene.textures, limit);
         let mut materials: Vec<GpuMaterial> = scene.objects.iter().map(|o| GpuMaterial::new(&o.material)).collect();
         if materials.is_empty() {
             // storage bindings may not be empty
@@ -117,11 +221,24 @@ impl SceneGeometry {
             contents: bytemuck::cast_slice(&materials),
             usage: wgpu::BufferUsages::STORAGE,
         });
+        let surface_buf = gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("scene vertex surfaces"),
+            contents: bytemuck::cast_slice(&surface),
+            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+        });
+        let texels_buf = gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("texels"),
+            contents: bytemuck::cast_slice(&texels),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
         let words = VertexWords { count: vertices.len() as u32, stride: 10, normals: 2, object_word: 9 };
         Ok(Self {
             vertices: vertices_buf,
             vertex_count: vertices.len() as u32,
             materials: materials_buf,
+            surface: surface_buf,
+            texels: texels_buf,
+            texture_halvings,
             bounds: union(objects.iter().map(|o| o.2)),
             placement: Placement::new(gpu, words, objects.len())?,
             objects,
@@ -179,6 +296,8 @@ impl SceneGeometry {
         if !vertices.is_empty() {
             let offset = u64::from(first) * std::mem::size_of::<ShadedVertex>() as u64;
             self.placement.write_vertices(gpu, &self.vertices, offset, bytemuck::cast_slice(&vertices));
+            let offset = u64::from(first) * std::mem::size_of::<SurfaceVertex>() as u64;
+            gpu.queue.write_buffer(&self.surface, offset, bytemuck::cast_slice(&surface_vertices(o)));
         }
         self.objects[object].2 = bounds;
         self.bounds = self.world_bounds();
@@ -189,6 +308,13 @@ impl SceneGeometry {
         array_stride: std::mem::size_of::<ShadedVertex>() as u64,
         step_mode: wgpu::VertexStepMode::Vertex,
         attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Uint32],
+    };
+
+    /// The second vertex buffer's layout ([`SceneGeometry::surface`]).
+    pub(crate) const SURFACE_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+        array_stride: std::mem::size_of::<SurfaceVertex>() as u64,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &wgpu::vertex_attr_array![4 => Float32x2, 5 => Uint32],
     };
 }
 

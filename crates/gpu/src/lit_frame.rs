@@ -526,6 +526,7 @@ impl LitFrame {
                     ambient: lights.ambient,
                     background: lights.background,
                     specular_ambient: lights.specular_ambient,
+                    lights_only: false,
                 };
                 self.shading.record_into(gpu, &mut encoder, geometry, receivers.gbuffer, &params, &vis, &target)?;
                 target

@@ -65,6 +65,9 @@ pub struct ShadeParams<'a> {
     /// The ambient map prefiltered for the specular lobe (split sum); without it only the
     /// lights reach the specular lobe.
     pub specular_ambient: Option<&'a SpecularAmbient>,
+    /// Only the lights: no emission from emitting materials (a pass whose output is added to
+    /// an image already shaded with it, as the split frame's indirect lights are).
+    pub lights_only: bool,
 }
 
 /// One visibility layer per light, screen-sized, 1 = lit.
@@ -182,7 +185,7 @@ pub struct ShadingPass {
 struct ShadeSlot {
     uniform: wgpu::Buffer,
     lights: wgpu::Buffer,
-    bind: crate::Keyed<(u64, [wgpu::Buffer; 2], [wgpu::Texture; 7]), wgpu::BindGroup>,
+    bind: crate::Keyed<(u64, [wgpu::Buffer; 3], [wgpu::Texture; 7]), wgpu::BindGroup>,
 }
 
 /// Output format of the shading pass: linear HDR radiance.
@@ -306,7 +309,12 @@ impl ShadingPass {
             right: rays.right.extend(0.0).to_array(),
             down: rays.down.extend(0.0).to_array(),
             corner: rays.corner.extend(0.0).to_array(),
-            counts: [params.lights.len() as u32, u32::from(params.ambient.is_some()), bw, bh],
+            counts: [
+                params.lights.len() as u32,
+                u32::from(params.ambient.is_some()) | u32::from(!params.lights_only) << 1,
+                bw,
+                bh,
+            ],
             ambient_info: params.specular_ambient.map_or([0; 4], |s| [s.size.0, s.size.1, s.size.2, s.table_size]),
             sh,
         };
@@ -354,7 +362,8 @@ impl ShadingPass {
             gpu.queue.write_buffer(&slot.uniform, 0, bytemuck::bytes_of(&uniform));
             crate::slots::write_grown(gpu, &mut slot.lights, "lights", wgpu::BufferUsages::STORAGE, light_bytes);
             let bytes = light_bytes.len() as u64;
-            let key = (bytes, [slot.lights.clone(), geometry.materials.clone()], textures.clone());
+            let key =
+                (bytes, [slot.lights.clone(), geometry.materials.clone(), geometry.texels.clone()], textures.clone());
             let (uniform, light_buf) = (&slot.uniform, &slot.lights);
             slot.bind
                 .get(key, || {
@@ -402,6 +411,7 @@ impl ShadingPass {
                                 binding: 9,
                                 resource: wgpu::BindingResource::TextureView(&table_view),
                             },
+                            wgpu::BindGroupEntry { binding: 10, resource: geometry.texels.as_entire_binding() },
                         ],
                     })
                 })

@@ -213,6 +213,7 @@ pub(crate) fn record_split_stamped(
             ambient: frame.lit.ambient,
             background: frame.lit.background,
             specular_ambient: frame.lit.specular_ambient,
+            lights_only: false,
         },
         direct_visibility,
         &targets.base,
@@ -239,7 +240,7 @@ pub(crate) fn record_split_stamped(
         encoder,
         geometry,
         low.gbuffer,
-        &ShadeParams { lights: indirects, ..Default::default() },
+        &ShadeParams { lights: indirects, lights_only: true, ..Default::default() },
         visibility,
         &targets.shaded,
     )?;

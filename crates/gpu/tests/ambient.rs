@@ -22,7 +22,7 @@ fn dfg_table_matches_brute_force_integration_of_the_lobe() {
         let wo = Vec3::new((1.0 - cos_o * cos_o).sqrt(), 0.0, cos_o);
         let [scale, bias] = table.lookup(cos_o, roughness);
         for f0 in [0.04f32, 0.5, 1.0] {
-            let m = Material { albedo: Vec3::ZERO, specular: Some(Ggx { roughness, f0: Vec3::splat(f0) }) };
+            let m = Material::rgb(Vec3::ZERO, Some(Ggx { roughness, f0: Vec3::splat(f0) }));
             // the integral of f cos over the hemisphere on a 1024 x 1024 grid in (cos theta, phi)
             let n = 1024;
             let mut sum = 0.0f64;
@@ -126,6 +126,7 @@ fn ambient_images(scene: &Scene, map: &EnvMap) -> (Vec<Vec3>, Vec<Vec3>, Vec<u32
         ambient: Some(&sh),
         background: Some(&background),
         specular_ambient: Some(&specular),
+        lights_only: false,
     };
     let image = ShadingPass::new(&gpu).unwrap().render(&gpu, &geometry, &gb, &params, &vis).unwrap();
     let ambient_map = AmbientMap::new(map).unwrap();
@@ -172,6 +173,7 @@ fn spheres(materials: &[Material]) -> Scene {
             height: 96,
         },
         point_lights: vec![],
+        textures: Vec::new(),
     }
 }
 
@@ -230,10 +232,7 @@ fn signed_sh9_ambient_on_diffuse_surfaces_matches_ref_tracer() {
 #[test]
 fn split_sum_specular_ambient_is_close_to_ref_tracer_exact_integral() {
     let map = residual_like();
-    let ggx = |roughness: f32, f0: Vec3, albedo: f32| Material {
-        albedo: Vec3::splat(albedo),
-        specular: Some(Ggx { roughness, f0 }),
-    };
+    let ggx = |roughness: f32, f0: Vec3, albedo: f32| Material::rgb(Vec3::splat(albedo), Some(Ggx { roughness, f0 }));
     let materials = [
         ggx(0.3, Vec3::splat(0.04), 0.5),
         ggx(0.6, Vec3::splat(0.04), 0.5),

@@ -51,10 +51,8 @@ fn interior(ids: &[u32], normals: &[Vec3], gpu_pos: &[[f32; 4]], w: usize, h: us
 #[test]
 fn shading_matches_ref_tracer_lights_without_shadows() {
     let gpu = gpu();
-    let glossy =
-        Material { albedo: Vec3::new(0.7, 0.5, 0.3), specular: Some(Ggx { roughness: 0.4, f0: Vec3::splat(0.04) }) };
-    let metal =
-        Material { albedo: Vec3::splat(0.2), specular: Some(Ggx { roughness: 0.55, f0: Vec3::new(0.9, 0.6, 0.3) }) };
+    let glossy = Material::rgb(Vec3::new(0.7, 0.5, 0.3), Some(Ggx { roughness: 0.4, f0: Vec3::splat(0.04) }));
+    let metal = Material::rgb(Vec3::splat(0.2), Some(Ggx { roughness: 0.55, f0: Vec3::new(0.9, 0.6, 0.3) }));
     let scene = Scene {
         name: "apart".into(),
         objects: vec![
@@ -71,6 +69,7 @@ fn shading_matches_ref_tracer_lights_without_shadows() {
         ],
         camera: camera(Vec3::new(0.0, 1.5, 6.5), Vec3::ZERO, 160, 96),
         point_lights: vec![],
+        textures: Vec::new(),
     };
     // No light direction reaches one object past the other (they are 3 m apart, lights high).
     let cone =
@@ -141,6 +140,7 @@ fn point_light_over_a_lambertian_plane_matches_the_closed_form() {
         }],
         camera: camera(Vec3::new(0.0, 4.0, 4.0), Vec3::ZERO, 96, 64),
         point_lights: vec![],
+        textures: Vec::new(),
     };
     let light = PointLight::point(Vec3::new(0.5, 1.5, -0.5), Vec3::new(4.0, 3.0, 2.0));
     let lights = [ShadeLight::from(&light)];
@@ -235,8 +235,7 @@ fn wide_cones_shade_as_the_ray_traced_cone() {
     // shadow on themselves above their horizon): the shading pass's cone integral against the
     // ray tracer's cone samples
     let gpu = gpu();
-    let glossy =
-        Material { albedo: Vec3::new(0.6, 0.5, 0.4), specular: Some(Ggx { roughness: 0.5, f0: Vec3::splat(0.04) }) };
+    let glossy = Material::rgb(Vec3::new(0.6, 0.5, 0.4), Some(Ggx { roughness: 0.5, f0: Vec3::splat(0.04) }));
     let scene = Scene {
         name: "cones".into(),
         objects: vec![
@@ -249,6 +248,7 @@ fn wide_cones_shade_as_the_ray_traced_cone() {
         ],
         camera: camera(Vec3::new(0.0, 0.5, 6.0), Vec3::ZERO, 128, 64),
         point_lights: vec![],
+        textures: Vec::new(),
     };
     let bvh = SceneBvh::new(&scene);
     for degrees in [5.0f32, 20.0, 45.0] {
@@ -333,6 +333,7 @@ fn gbuffer_objects_are_the_primary_rays_hits_at_every_scale() {
                 height: 960,
             },
             point_lights: vec![],
+            textures: Vec::new(),
         };
         let geometry = SceneGeometry::upload(&gpu, &scene).unwrap();
         let gb = GBufferPass::new(&gpu).render(&gpu, &geometry, &scene.camera).unwrap();
@@ -386,6 +387,7 @@ fn weber_negligible_lights_are_below_two_percent_at_every_receiver() {
         ],
         camera: camera(Vec3::new(3.0, 4.0, 6.0), Vec3::new(0.0, 0.5, 0.0), 128, 96),
         point_lights: vec![],
+        textures: Vec::new(),
     };
     let geometry = SceneGeometry::upload(&gpu, &scene).unwrap();
     let gb = GBufferPass::new(&gpu).render(&gpu, &geometry, &scene.camera).unwrap();
@@ -434,6 +436,7 @@ fn a_callers_device_renders_the_same_and_is_counted() {
         }],
         camera: camera(Vec3::new(0.0, 2.0, 3.0), Vec3::ZERO, 32, 24),
         point_lights: vec![],
+        textures: Vec::new(),
     };
     let light = [ShadeLight::Distant { direction: Vec3::Y, irradiance: Vec3::ONE, half_angle: 0.0 }];
     let params = ShadeParams { lights: &light, ..ShadeParams::default() };

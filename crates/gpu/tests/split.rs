@@ -72,7 +72,7 @@ impl ShadowTechnique for Stripes {
 }
 
 fn object(name: &str, mesh: Mesh, albedo: Vec3) -> Object {
-    Object { name: name.into(), mesh, material: Material { albedo, specular: None } }
+    Object { name: name.into(), mesh, material: Material::rgb(albedo, None) }
 }
 
 /// A red box and a one-pixel-wide white pole in front of a grey wall on a green floor.
@@ -103,6 +103,7 @@ fn stage(width: u32, height: u32) -> Scene {
             height,
         },
         point_lights: vec![],
+        textures: Vec::new(),
     }
 }
 

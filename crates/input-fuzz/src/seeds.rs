@@ -127,7 +127,8 @@ pub fn lights_json() -> Vec<Vec<u8>> {
 }
 
 /// A model written by hand: a cube (u16 indices) and its points under a TRS parent, through a
-/// matrix node; a quad as a u8 triangle strip; a material and a camera. Its document and buffer.
+/// matrix node; a quad as a u8 triangle strip with texture coordinates and a base colour
+/// texture (a 2 x 2 PNG in the buffer); two materials and a camera. Its document and buffer.
 fn handmade() -> (serde_json::Value, Vec<u8>) {
     let f32s = |v: &[[f32; 3]]| -> Vec<u8> { v.iter().flatten().flat_map(|f| f.to_le_bytes()).collect() };
     let corners: Vec<[f32; 3]> =
@@ -139,6 +140,16 @@ fn handmade() -> (serde_json::Value, Vec<u8>) {
     bin.extend(cube.iter().flat_map(|i| i.to_le_bytes()));
     bin.extend(f32s(&quad));
     bin.extend([0u8, 1, 2, 3]);
+    bin.extend([[0.0f32, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]].iter().flatten().flat_map(|f| f.to_le_bytes()));
+    let mut png = std::io::Cursor::new(Vec::new());
+    let texels = image::RgbaImage::from_fn(2, 2, |x, y| image::Rgba([200 * x as u8, 200 * y as u8, 90, 255]));
+    // an encoder's failure leaves the view empty, which the import refuses: still a seed
+    let _ = texels.write_to(&mut png, image::ImageFormat::Png);
+    let png = png.into_inner();
+    bin.extend(&png);
+    while !bin.len().is_multiple_of(4) {
+        bin.push(0);
+    }
     let doc = serde_json::json!({
         "asset": {"version": "2.0", "generator": "input-fuzz"},
         "scene": 0,
@@ -154,9 +165,13 @@ fn handmade() -> (serde_json::Value, Vec<u8>) {
         "meshes": [
             {"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0, "mode": 4},
                             {"attributes": {"POSITION": 0}, "mode": 0}]},
-            {"primitives": [{"attributes": {"POSITION": 2}, "indices": 3, "mode": 5}]}
+            {"primitives": [{"attributes": {"POSITION": 2, "TEXCOORD_0": 4}, "indices": 3, "mode": 5, "material": 1}]}
         ],
-        "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.6, 0.4, 1.0]}, "doubleSided": true}],
+        "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.6, 0.4, 1.0]}, "doubleSided": true},
+                      {"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0.0}}],
+        "textures": [{"source": 0, "sampler": 0}],
+        "samplers": [{"magFilter": 9729, "wrapS": 33648, "wrapT": 33071}],
+        "images": [{"bufferView": 5, "mimeType": "image/png"}],
         "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.01, "aspectRatio": 1.333}}],
         "accessors": [
             {"bufferView": 0, "componentType": 5126, "count": 8, "type": "VEC3",
@@ -164,15 +179,18 @@ fn handmade() -> (serde_json::Value, Vec<u8>) {
             {"bufferView": 1, "componentType": 5123, "count": 36, "type": "SCALAR"},
             {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC3",
              "min": [0.0, 0.0, 0.0], "max": [1.0, 0.0, 1.0]},
-            {"bufferView": 3, "componentType": 5121, "count": 4, "type": "SCALAR"}
+            {"bufferView": 3, "componentType": 5121, "count": 4, "type": "SCALAR"},
+            {"bufferView": 4, "componentType": 5126, "count": 4, "type": "VEC2"}
         ],
         "bufferViews": [
             {"buffer": 0, "byteOffset": 0, "byteLength": 96, "target": 34962},
             {"buffer": 0, "byteOffset": 96, "byteLength": 72, "target": 34963},
             {"buffer": 0, "byteOffset": 168, "byteLength": 48, "target": 34962},
-            {"buffer": 0, "byteOffset": 216, "byteLength": 4, "target": 34963}
+            {"buffer": 0, "byteOffset": 216, "byteLength": 4, "target": 34963},
+            {"buffer": 0, "byteOffset": 220, "byteLength": 32, "target": 34962},
+            {"buffer": 0, "byteOffset": 252, "byteLength": png.len()}
         ],
-        "buffers": [{"byteLength": 220}]
+        "buffers": [{"byteLength": bin.len()}]
     });
     (doc, bin)
 }
@@ -214,7 +232,12 @@ pub fn glb() -> Vec<Vec<u8>> {
 /// case that claims the most allowed stays within [`crate::CASE_ALLOCATION_LIMIT`].
 #[must_use]
 pub fn gltf_options() -> scene::import::GltfOptions {
-    scene::import::GltfOptions { size: (64, 48), max_triangles: 1 << 20, ..scene::import::GltfOptions::default() }
+    scene::import::GltfOptions {
+        size: (64, 48),
+        max_triangles: 1 << 20,
+        max_texture_bytes: 16 << 20,
+        ..scene::import::GltfOptions::default()
+    }
 }
 
 /// The loaders the commands use, on the seeds above: maps (`info`, `extract`, `--envmap`, the

@@ -143,7 +143,7 @@ fn lights_and_residual_render_a_lone_glossy_sphere_like_the_map() {
         objects: vec![Object {
             name: "sphere".into(),
             mesh: Mesh::icosphere(Vec3::ZERO, 1.0, 4),
-            material: Material { albedo: Vec3::ZERO, specular: Some(Ggx { roughness: 0.2, f0: Vec3::splat(0.9) }) },
+            material: Material::rgb(Vec3::ZERO, Some(Ggx { roughness: 0.2, f0: Vec3::splat(0.9) })),
         }],
         camera: Camera {
             eye: Vec3::new(1.0, 1.0, 4.0),
@@ -154,6 +154,7 @@ fn lights_and_residual_render_a_lone_glossy_sphere_like_the_map() {
             height: 30,
         },
         point_lights: vec![],
+        textures: Vec::new(),
     };
     let bvh = SceneBvh::new(&scene);
     let settings = RenderSettings { spp: 256, seed: 1, aovs: true, pixel_positions: Some(8), ..Default::default() };

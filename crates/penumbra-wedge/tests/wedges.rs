@@ -520,12 +520,14 @@ fn gpu_silhouettes_are_the_cpu_builders() {
         positions: vec![a, b, Vec3::new(-2.2, 1.0, 0.5), Vec3::new(-1.0, 1.9, 0.5), Vec3::new(-0.9, 0.8, 0.4)],
         normals: None,
         indices: vec![[0, 1, 2], [0, 1, 3], [1, 0, 4]],
+        uvs: None,
     };
     let (c, d) = (Vec3::new(1.4, 1.0, -0.5), Vec3::new(1.9, 1.0, -0.5));
     let fold = scene::Mesh {
         positions: vec![c, d, Vec3::new(1.6, 1.3, 0.2), Vec3::new(1.7, 1.4, -1.1)],
         normals: None,
         indices: vec![[0, 1, 2], [0, 1, 3]],
+        uvs: None,
     };
     for (name, mesh) in [("fan", fan), ("fold", fold)] {
         odd.objects.push(scene::Object { name: name.into(), mesh, material: scene::Material::lambert(0.5) });

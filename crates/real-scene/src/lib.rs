@@ -96,11 +96,22 @@ impl RealScene {
             .enumerate()
             .map(|(k, p)| scene::Object {
                 name: format!("patch_{k}"),
-                mesh: scene::Mesh { positions: p.corners.to_vec(), normals: None, indices: vec![[0, 1, 2], [0, 2, 3]] },
-                material: scene::Material { albedo: p.reflectance, specular: None },
+                mesh: scene::Mesh {
+                    positions: p.corners.to_vec(),
+                    normals: None,
+                    indices: vec![[0, 1, 2], [0, 2, 3]],
+                    uvs: None,
+                },
+                material: scene::Material::rgb(p.reflectance, None),
             })
             .collect();
-        scene::Scene { name: self.name.clone(), objects, camera: self.camera, point_lights: Vec::new() }
+        scene::Scene {
+            name: self.name.clone(),
+            objects,
+            camera: self.camera,
+            point_lights: Vec::new(),
+            textures: Vec::new(),
+        }
     }
 
     /// The point synthetic objects are placed from: the centre of the floor (the bounds' centre

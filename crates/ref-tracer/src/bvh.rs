@@ -2,14 +2,14 @@
 //! and the surface point of a hit. Traversal is obvhs's `traverse!` with our node and triangle
 //! tests: no absolute epsilon anywhere, so images do not depend on the scene's scale.
 
-use glam::{UVec2, Vec3, Vec3A};
+use glam::{UVec2, Vec2, Vec3, Vec3A};
 use obvhs::BvhBuildParams;
 use obvhs::cwbvh::CwBvh;
 use obvhs::cwbvh::builder::build_cwbvh_from_tris;
 use obvhs::cwbvh::node::CwBvhNode;
 use obvhs::ray::Ray;
 use obvhs::triangle::Triangle;
-use scene::{Material, Mesh, Scene};
+use scene::{Material, Mesh, Scene, Texture};
 
 /// A ray's closest hit, resolved to a surface point.
 #[derive(Clone, Copy, Debug)]
@@ -28,6 +28,8 @@ pub struct SurfacePoint {
     /// True when the ray hit the triangle's front side (counter-clockwise as the ray sees it):
     /// one-sided emitters emit from there.
     pub front: bool,
+    /// Texture coordinates, interpolated (zero where the mesh has none).
+    pub uv: Vec2,
 }
 
 /// A BVH over every triangle of a scene.
@@ -39,6 +41,9 @@ pub struct SceneBvh {
     /// per triangle, in the same order: (object, triangle within the object)
     owners: Vec<(u32, u32)>,
     materials: Vec<Material>,
+    textures: Vec<Texture>,
+    /// whether any material emits
+    emits: bool,
     /// per object: its mesh, for interpolating vertex normals
     meshes: Vec<Mesh>,
     scale: f32,
@@ -129,6 +134,8 @@ impl SceneBvh {
             triangles,
             owners,
             materials: scene.objects.iter().map(|o| o.material).collect(),
+            textures: scene.textures.clone(),
+            emits: scene.objects.iter().any(|o| o.material.emits()),
             meshes: scene.objects.iter().map(|o| o.mesh.clone()).collect(),
             scale,
         }
@@ -138,6 +145,47 @@ impl SceneBvh {
     #[must_use]
     pub fn material(&self, object: u32) -> &Material {
         &self.materials[object as usize]
+    }
+
+    /// The material where `sp` is: object `sp.object`'s, its textures sampled at `sp.uv`.
+    #[must_use]
+    pub fn material_at(&self, sp: &SurfacePoint) -> Material {
+        self.materials[sp.object as usize].at(&self.textures, sp.uv)
+    }
+
+    /// Radiance the material emits toward the ray that found `sp`: its emission (textured)
+    /// from the front, or from either side where it is double-sided.
+    #[must_use]
+    pub fn emission_at(&self, sp: &SurfacePoint) -> Vec3 {
+        let m = &self.materials[sp.object as usize];
+        if !m.emits() || !(sp.front || m.double_sided) {
+            return Vec3::ZERO;
+        }
+        m.at(&self.textures, sp.uv).emission
+    }
+
+    /// Whether any material emits (so a path's last bounce ray is worth tracing).
+    #[must_use]
+    pub fn emits(&self) -> bool {
+        self.emits
+    }
+
+    /// The closest hit a camera sees along `origin + t dir`: as [`Self::intersect`], past the
+    /// back faces of one-sided materials (glTF's back-face culling; shadow and bounce rays see
+    /// both sides).
+    #[must_use]
+    pub fn intersect_camera(&self, origin: Vec3, dir: Vec3) -> Option<SurfacePoint> {
+        let mut t_min = 0.0;
+        // a bounded walk: each step passes one culled face at a strictly larger distance
+        for _ in 0..256 {
+            let (id, t) = self.closest(origin, dir, t_min, f32::INFINITY)?;
+            let sp = self.surface(id as usize, origin, dir, t);
+            if sp.front || self.materials[sp.object as usize].double_sided {
+                return Some(sp);
+            }
+            t_min = t;
+        }
+        None
     }
 
     /// Offset that moves a ray origin off a surface: relative to the scene's extent, so tiny and
@@ -150,7 +198,12 @@ impl SceneBvh {
     /// The closest hit along `origin + t dir`, t in (0, t_max).
     #[must_use]
     pub fn intersect(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<SurfacePoint> {
-        let mut ray = Ray::new(origin.into(), dir.into(), 0.0, t_max);
+        self.closest(origin, dir, 0.0, t_max).map(|(id, t)| self.surface(id as usize, origin, dir, t))
+    }
+
+    /// The closest triangle (in BVH order) and its distance, t in (t_min, t_max).
+    fn closest(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Option<(u32, f32)> {
+        let mut ray = Ray::new(origin.into(), dir.into(), t_min, t_max);
         let mut hit = None;
         let mut state = self.bvh.new_traversal(ray.direction);
         let mut node: &CwBvhNode;
@@ -161,7 +214,7 @@ impl SceneBvh {
                 ray.tmax = t;
             }
         });
-        hit.map(|id| self.surface(id as usize, origin, dir, ray.tmax))
+        hit.map(|id| (id, ray.tmax))
     }
 
     /// Whether anything blocks `origin + t dir` for t in (0, t_max).
@@ -186,14 +239,19 @@ impl SceneBvh {
         let mut ng = tri.n.normalize_or(Vec3::Y);
         let (object, local) = self.owners[tri_index];
         let mesh = &self.meshes[object as usize];
+        let b = barycentric(position, tri);
+        let corners = mesh.indices[local as usize];
         let mut ns = match &mesh.normals {
             Some(normals) => {
-                let b = barycentric(position, tri);
-                let [i0, i1, i2] = mesh.indices[local as usize].map(|i| normals[i as usize]);
+                let [i0, i1, i2] = corners.map(|i| normals[i as usize]);
                 (i0 * b.x + i1 * b.y + i2 * b.z).normalize_or(ng)
             }
             None => ng,
         };
+        let uv = mesh.uvs.as_ref().map_or(Vec2::ZERO, |uvs| {
+            let [a, b1, c] = corners.map(|i| uvs[i as usize]);
+            a * b.x + b1 * b.y + c * b.z
+        });
         let front = ng.dot(dir) < 0.0;
         if !front {
             ng = -ng;
@@ -201,7 +259,7 @@ impl SceneBvh {
         if ns.dot(ng) < 0.0 {
             ns = -ns;
         }
-        SurfacePoint { t, position, geometric_normal: ng, shading_normal: ns, object, front }
+        SurfacePoint { t, position, geometric_normal: ng, shading_normal: ns, object, front, uv }
     }
 }
 

@@ -114,6 +114,7 @@ mod tests {
                 .collect(),
             camera: Camera { eye: Vec3::Y, target: Vec3::ZERO, up: Vec3::Z, hfov_degrees: 60.0, width: 4, height: 4 },
             point_lights: Vec::new(),
+            textures: Vec::new(),
         }
     }
 

@@ -159,24 +159,25 @@ fn power_heuristic(a: f32, b: f32) -> f32 {
 }
 
 /// Everything an estimator needs at a surface point.
-struct Shading<'a> {
+struct Shading {
     p: Vec3,
     ng: Vec3,
     frame: Frame,
     wo: Vec3,
-    material: &'a scene::Material,
+    /// the material at the point, its textures sampled
+    material: scene::Material,
     eps: f32,
 }
 
-impl Shading<'_> {
-    fn new<'b>(bvh: &'b SceneBvh, sp: &SurfacePoint, ray_dir: Vec3) -> Shading<'b> {
+impl Shading {
+    fn new(bvh: &SceneBvh, sp: &SurfacePoint, ray_dir: Vec3) -> Self {
         let frame = Frame::new(sp.shading_normal);
         Shading {
             p: sp.position,
             ng: sp.geometric_normal,
             wo: frame.to_local(-ray_dir),
             frame,
-            material: bvh.material(sp.object),
+            material: bvh.material_at(sp),
             eps: bvh.epsilon(),
         }
     }
@@ -209,14 +210,16 @@ impl Integrator<'_> {
         match self {
             Self::EnvDirect(strategy) => {
                 let env = env.expect("EnvDirect needs the map");
-                match bvh.intersect(origin, dir, f32::INFINITY) {
+                match bvh.intersect_camera(origin, dir) {
                     None => env.map.lookup(dir),
-                    Some(sp) => env_direct(bvh, env, &Shading::new(bvh, &sp, dir), *strategy, false, s).0,
+                    Some(sp) => {
+                        bvh.emission_at(&sp) + env_direct(bvh, env, &Shading::new(bvh, &sp, dir), *strategy, false, s).0
+                    }
                 }
             }
-            Self::Lights(set) => match bvh.intersect(origin, dir, f32::INFINITY) {
+            Self::Lights(set) => match bvh.intersect_camera(origin, dir) {
                 None => set.background.map_or(Vec3::ZERO, |m| m.lookup(dir)),
-                Some(sp) => lights_direct(bvh, set, &Shading::new(bvh, &sp, dir), s),
+                Some(sp) => bvh.emission_at(&sp) + lights_direct(bvh, set, &Shading::new(bvh, &sp, dir), s),
             },
             Self::Path { max_depth } => {
                 path(bvh, Some(env.expect("Path needs the map")), None, origin, dir, *max_depth, s)
@@ -401,10 +404,11 @@ fn path(
         Some(e) if sp.front => e.emission(sp.object),
         _ => Vec3::ZERO,
     };
-    let Some(mut sp) = bvh.intersect(origin, dir, f32::INFINITY) else {
+    let Some(mut sp) = bvh.intersect_camera(origin, dir) else {
         return env.map_or(Vec3::ZERO, |e| e.map.lookup(dir));
     };
-    let (mut l, mut beta) = (emitted(&sp), Vec3::ONE);
+    // emitting materials are found by BRDF samples only (no next-event estimation toward them)
+    let (mut l, mut beta) = (emitted(&sp) + bvh.emission_at(&sp), Vec3::ONE);
     let mut d = dir;
     for depth in 0..max_depth {
         let sh = Shading::new(bvh, &sp, d);
@@ -417,7 +421,8 @@ fn path(
             Some(env) => {
                 // NEE with MIS; a BRDF ray that escapes is counted inside env_direct, so the
                 // path continues only through its hit
-                let (direct, next) = env_direct(bvh, env, &sh, Strategy::Mis, !last || emitters.is_some(), s);
+                let (direct, next) =
+                    env_direct(bvh, env, &sh, Strategy::Mis, !last || emitters.is_some() || bvh.emits(), s);
                 l += beta * direct;
                 next
             }
@@ -425,6 +430,7 @@ fn path(
         };
         let Some(Continuation { dir: wi, weight, pdf, hit: Some(hit) }) = next else { break };
         beta *= weight;
+        l += beta * bvh.emission_at(&hit);
         let le = emitted(&hit);
         if le != Vec3::ZERO
             && let Some(e) = emitters

@@ -150,7 +150,7 @@ pub fn render(
         .map(|pixel| {
             let (x, y) = ((pixel as u32 % w) as f32 + 0.5, (pixel as u32 / w) as f32 + 0.5);
             let (o, d) = cam.ray(x, y);
-            bvh.intersect(o, d, f32::INFINITY).map(|sp| (sp, bvh.material(sp.object).albedo))
+            bvh.intersect_camera(o, d).map(|sp| (sp, bvh.material_at(&sp).albedo))
         })
         .collect();
     for (pixel, aov) in aovs.into_iter().enumerate() {

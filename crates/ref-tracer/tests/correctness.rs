@@ -64,6 +64,7 @@ fn lone_sphere(albedo: f32) -> Scene {
             height: 30,
         },
         point_lights: vec![],
+        textures: Vec::new(),
     }
 }
 
@@ -169,7 +170,7 @@ fn mis_pdfs_are_the_pdfs_of_the_samples_drawn() {
     let frame = scene::brdf::Frame::new(Vec3::new(-0.5, 0.6, 0.62).normalize());
     let wo = Vec3::new(0.6, 0.1, 0.79).normalize();
     for roughness in [0.15, 0.5] {
-        let m = Material { albedo: Vec3::splat(0.5), specular: Some(scene::Ggx { roughness, f0: Vec3::splat(0.04) }) };
+        let m = Material::rgb(Vec3::splat(0.5), Some(scene::Ggx { roughness, f0: Vec3::splat(0.04) }));
         let (chi2, dof) = sphere_chi_square(
             n,
             || {
@@ -309,6 +310,7 @@ fn plane() -> Scene {
             height: 12,
         },
         point_lights: vec![],
+        textures: Vec::new(),
     }
 }
 

@@ -23,6 +23,7 @@ fn furnace(a: f32) -> Scene {
             height: 8,
         },
         point_lights: Vec::new(),
+        textures: Vec::new(),
     }
 }
 
@@ -83,6 +84,7 @@ fn one_emitting_face_lights_the_opposite_face_by_its_form_factor() {
             height: 2,
         },
         point_lights: Vec::new(),
+        textures: Vec::new(),
     };
     let emitters = Emitters::new(&scene, &[le, Vec3::ZERO]);
     let r = render(
@@ -124,6 +126,7 @@ fn emitters_are_one_sided() {
                 height: 4,
             },
             point_lights: Vec::new(),
+            textures: Vec::new(),
         }
     };
     for (flip, expected) in [(false, 3.0), (true, 0.0)] {

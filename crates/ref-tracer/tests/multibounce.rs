@@ -36,6 +36,7 @@ fn integrating_sphere(material: Material, port_y: f32) -> (Scene, f64) {
             height: 32,
         },
         point_lights: Vec::new(),
+        textures: Vec::new(),
     };
     (scene, 1.0 - kept / total)
 }
@@ -60,7 +61,7 @@ fn mean_and_error(r: &Render) -> (Vec3, Vec3) {
 fn integrating_sphere_sums_the_geometric_series_per_depth() {
     let rho = Vec3::new(0.8, 0.6, 0.4);
     let l = Vec3::new(1.0, 2.0, 0.5);
-    let (scene, f) = integrating_sphere(Material { albedo: rho, specular: None }, 0.8);
+    let (scene, f) = integrating_sphere(Material::rgb(rho, None), 0.8);
     // a cap above y = 0.8 has f = 0.1 on the exact sphere
     assert!((f - 0.1).abs() < 0.01, "port fraction {f}");
     let f = f as f32;
@@ -90,7 +91,7 @@ fn ggx_walls_never_outshine_the_sky_and_bounces_only_add_light() {
     let l = Vec3::splat(1.5);
     let map = EnvMap::constant(64, 32, l);
     for roughness in [0.2f32, 0.6] {
-        let material = Material { albedo: Vec3::ZERO, specular: Some(Ggx { roughness, f0: Vec3::ONE }) };
+        let material = Material::rgb(Vec3::ZERO, Some(Ggx { roughness, f0: Vec3::ONE }));
         let (scene, _) = integrating_sphere(material, 0.6);
         let mut last = Vec3::ZERO;
         for depth in [1u32, 2, 4, 8, 24] {

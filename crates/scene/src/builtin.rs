@@ -58,6 +58,7 @@ fn spheres_box() -> Scene {
         ],
         camera: camera(Vec3::new(0.5, 2.5, 7.0), Vec3::new(0.0, 0.9, 0.0), 40.0),
         point_lights: vec![],
+        textures: Vec::new(),
     }
 }
 
@@ -77,6 +78,7 @@ fn three_boxes() -> Scene {
         objects,
         camera: camera(Vec3::new(0.0, 3.5, 7.5), Vec3::new(0.0, 0.5, 0.0), 45.0),
         point_lights: vec![],
+        textures: Vec::new(),
     }
 }
 
@@ -90,6 +92,7 @@ fn column() -> Scene {
         ],
         camera: camera(Vec3::new(2.5, 3.0, 6.5), Vec3::new(0.0, 1.2, 0.0), 45.0),
         point_lights: vec![],
+        textures: Vec::new(),
     }
 }
 
@@ -103,26 +106,27 @@ fn glossy_set() -> Scene {
             object(
                 "diffuse_sphere",
                 Mesh::icosphere(Vec3::new(-2.4, 0.7, 0.0), 0.7, 4),
-                Material { albedo: Vec3::new(0.8, 0.3, 0.25), specular: None },
+                Material::rgb(Vec3::new(0.8, 0.3, 0.25), None),
             ),
             object(
                 "rough_sphere",
                 Mesh::icosphere(Vec3::new(-0.8, 0.7, 0.0), 0.7, 4),
-                Material { albedo: Vec3::new(0.3, 0.7, 0.3), specular: ggx(0.6, 0.04) },
+                Material::rgb(Vec3::new(0.3, 0.7, 0.3), ggx(0.6, 0.04)),
             ),
             object(
                 "semi_glossy_sphere",
                 Mesh::icosphere(Vec3::new(0.8, 0.7, 0.0), 0.7, 4),
-                Material { albedo: Vec3::new(0.25, 0.35, 0.8), specular: ggx(0.3, 0.04) },
+                Material::rgb(Vec3::new(0.25, 0.35, 0.8), ggx(0.3, 0.04)),
             ),
             object(
                 "glossy_box",
                 Mesh::cuboid(Vec3::new(1.9, 0.0, -0.6), Vec3::new(3.1, 1.2, 0.6)),
-                Material { albedo: Vec3::splat(0.2), specular: ggx(0.2, 0.5) },
+                Material::rgb(Vec3::splat(0.2), ggx(0.2, 0.5)),
             ),
         ],
         camera: camera(Vec3::new(0.0, 2.6, 7.5), Vec3::new(0.0, 0.6, 0.0), 45.0),
         point_lights: vec![],
+        textures: Vec::new(),
     }
 }
 
@@ -136,12 +140,12 @@ fn gallery() -> Scene {
     let gold = Vec3::new(1.0, 0.78, 0.34);
     let silver = Vec3::new(0.97, 0.96, 0.91);
     let spheres = [
-        ("diffuse_sphere", Material { albedo: Vec3::new(0.8, 0.35, 0.3), specular: None }),
-        ("rough_sphere", Material { albedo: Vec3::new(0.3, 0.7, 0.35), specular: ggx(0.7, dielectric) }),
-        ("semi_glossy_sphere", Material { albedo: Vec3::new(0.3, 0.4, 0.8), specular: ggx(0.35, dielectric) }),
-        ("glossy_sphere", Material { albedo: Vec3::splat(0.7), specular: ggx(0.15, dielectric) }),
-        ("rough_gold_sphere", Material { albedo: Vec3::ZERO, specular: ggx(0.5, gold) }),
-        ("polished_silver_sphere", Material { albedo: Vec3::ZERO, specular: ggx(0.2, silver) }),
+        ("diffuse_sphere", Material::rgb(Vec3::new(0.8, 0.35, 0.3), None)),
+        ("rough_sphere", Material::rgb(Vec3::new(0.3, 0.7, 0.35), ggx(0.7, dielectric))),
+        ("semi_glossy_sphere", Material::rgb(Vec3::new(0.3, 0.4, 0.8), ggx(0.35, dielectric))),
+        ("glossy_sphere", Material::rgb(Vec3::splat(0.7), ggx(0.15, dielectric))),
+        ("rough_gold_sphere", Material::rgb(Vec3::ZERO, ggx(0.5, gold))),
+        ("polished_silver_sphere", Material::rgb(Vec3::ZERO, ggx(0.2, silver))),
     ];
     let mut objects = vec![object("ground", ground(20.0), Material::lambert(0.5))];
     for (k, (name, material)) in spheres.into_iter().enumerate() {
@@ -157,7 +161,7 @@ fn gallery() -> Scene {
         (
             Vec3::new(1.0, 0.0, -3.2),
             Vec3::new(2.6, 0.8, -2.2),
-            Material { albedo: Vec3::splat(0.25), specular: ggx(0.3, Vec3::splat(0.5)) },
+            Material::rgb(Vec3::splat(0.25), ggx(0.3, Vec3::splat(0.5))),
         ),
     ];
     for (k, (lo, hi, material)) in boxes.into_iter().enumerate() {
@@ -168,6 +172,7 @@ fn gallery() -> Scene {
         objects,
         camera: camera(Vec3::new(0.0, 2.8, 8.5), Vec3::new(0.0, 0.6, -0.5), 55.0),
         point_lights: vec![],
+        textures: Vec::new(),
     }
 }
 
@@ -189,5 +194,6 @@ fn room() -> Scene {
         ],
         camera: camera(Vec3::new(3.6, 3.2, 3.6), Vec3::new(-0.5, 1.0, -0.5), 70.0),
         point_lights: vec![PointLight::point(Vec3::new(0.0, 2.0, 0.0), Vec3::splat(10.0))],
+        textures: Vec::new(),
     }
 }

@@ -3,7 +3,8 @@
 //!
 //! One node and one mesh per object, in the scene's order, positions in world space (no node
 //! transforms), vertex normals where the object shades with them; the albedo as the base colour
-//! (metallic 0); the camera as a perspective camera on its own node; point lights as
+//! (metallic 0), the emission, `doubleSided` (textures are not written: a textured object
+//! goes out with its factors); the camera as a perspective camera on its own node; point lights as
 //! `KHR_lights_punctual` point lights. What glTF cannot say exactly rides in `extras.envshadow`,
 //! read back only where it agrees with the standard data (so a file edited elsewhere is read
 //! by its standard fields): a GGX layer's roughness and F0, the camera's exact eye, target, up
@@ -65,9 +66,21 @@ impl Scene {
             let a = o.material.albedo;
             let mut material = json!({"name": o.name, "pbrMetallicRoughness": {
                 "baseColorFactor": [num(a.x), num(a.y), num(a.z), 1.0], "metallicFactor": 0.0,
-                "roughnessFactor": num(o.material.specular.map_or(1.0, |g| g.roughness))}});
-            if let Some(g) = o.material.specular {
-                material["extras"] = json!({EXTRAS_KEY: {"ggx": {"roughness": num(g.roughness), "f0": vec3(g.f0)}}});
+                "roughnessFactor": num(o.material.specular.map_or(1.0, |g| g.roughness))},
+                "doubleSided": o.material.double_sided});
+            material["extras"] = match o.material.specular {
+                Some(g) => json!({EXTRAS_KEY: {"ggx": {"roughness": num(g.roughness), "f0": vec3(g.f0)}}}),
+                None => json!({EXTRAS_KEY: {"lambert": true}}),
+            };
+            let e = o.material.emission;
+            if e != Vec3::ZERO {
+                // glTF's factor stops at 1; the strength extension carries the rest
+                let peak = e.max_element();
+                material["emissiveFactor"] = vec3(e / peak.max(1.0));
+                if peak > 1.0 {
+                    material["extensions"] =
+                        json!({"KHR_materials_emissive_strength": {"emissiveStrength": num(peak)}});
+                }
             }
             materials.push(material);
             meshes
@@ -106,9 +119,16 @@ impl Scene {
             "nodes": nodes, "meshes": meshes, "materials": materials, "cameras": cameras,
             "accessors": accessors, "bufferViews": views, "buffers": [buffer],
         });
+        let mut used = Vec::new();
+        if self.objects.iter().any(|o| o.material.emission.max_element() > 1.0) {
+            used.push("KHR_materials_emissive_strength");
+        }
         if !lights.is_empty() {
-            doc["extensionsUsed"] = json!(["KHR_lights_punctual"]);
+            used.push("KHR_lights_punctual");
             doc["extensions"] = json!({"KHR_lights_punctual": {"lights": lights}});
+        }
+        if !used.is_empty() {
+            doc["extensionsUsed"] = json!(used);
         }
         (doc, bin)
     }

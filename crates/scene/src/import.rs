@@ -2,25 +2,41 @@
 //! into the [`Scene`] every renderer here draws: the default scene's node hierarchy (TRS and
 //! matrix transforms), every triangle primitive (strips and fans converted; points and lines
 //! skipped and counted), u8/u16/u32 indices, normals where the file has them (flat shading
-//! otherwise), the base colour factor as the albedo, the first perspective camera (else one that
-//! frames the model) and `KHR_lights_punctual` point lights; what [`Scene::write_gltf`] adds in
-//! `extras` (GGX layers, the exact camera and lights) where it agrees with the standard data.
+//! otherwise), the first perspective camera (else one that frames the model) and
+//! `KHR_lights_punctual` point lights; what [`Scene::write_gltf`] adds in `extras` (exact
+//! Lambertian and GGX layers, the exact camera and lights) where it agrees with the standard data.
 //!
-//! Every accessor is checked against its buffer view and buffer before it is read, so a file
-//! that lies about its sizes is an error, not a panic, and nothing is allocated past
-//! [`GltfOptions::max_triangles`]. What the file holds that is not modelled is listed in
+//! Materials are glTF's metallic-roughness model as [`Material::metallic_roughness`] maps it
+//! onto ours: the base colour, metallic and roughness factors, their textures (base colour
+//! and emissive in sRGB, metallic-roughness linear; PNG or JPEG, through TEXCOORD_0, kept in
+//! [`Scene::textures`] and sampled per hit as [`Material::at`] says), the emissive factor (with
+//! `KHR_materials_emissive_strength`) and texture, and `doubleSided` (one-sided back faces are
+//! culled for the camera).
+//!
+//! Every accessor is checked against its buffer view and buffer before it is read, and every
+//! image's size from its header before it is decoded, so a file that lies about its sizes is an
+//! error, not a panic, and nothing is allocated past [`GltfOptions::max_triangles`] or
+//! [`GltfOptions::max_texture_bytes`]. What the file holds that is not modelled is listed in
 //! [`GltfImport::warnings`], once per kind.
 
-use crate::{Camera, Ggx, Material, Mesh, Object, PointLight, Scene};
-use glam::{Affine3A, Mat4, Vec3};
+use crate::texture::{Filter, Texture, Wrap};
+use crate::{Camera, Ggx, Maps, Material, Mesh, Object, PointLight, Scene};
+use glam::{Affine3A, Mat4, Vec2, Vec3};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 use serde_json::Value;
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// Files larger than this are refused before they are read (4 GiB).
 pub const MAX_FILE_BYTES: u64 = 4 << 30;
+
+/// Widest and tallest texture decoded (larger are refused before decoding).
+pub const MAX_TEXTURE_SIDE: u32 = 16384;
+
+/// Texel bytes all of a file's textures may take together by default (1 GiB; see
+/// [`GltfOptions::max_texture_bytes`]).
+pub const MAX_TEXTURE_BYTES: u64 = 1 << 30;
 
 /// Why a glTF file could not be imported; each message names the file.
 #[derive(Debug, thiserror::Error)]
@@ -81,12 +97,21 @@ pub struct GltfOptions {
     pub ground: Option<f32>,
     /// Triangles refused beyond (before their indices are allocated).
     pub max_triangles: usize,
+    /// Texel bytes (4 a texel) all textures may take together, refused beyond before decoding.
+    pub max_texture_bytes: u64,
 }
 
 impl Default for GltfOptions {
-    /// 640 × 480, the file's first camera, no ground, up to 50 million triangles.
+    /// 640 × 480, the file's first camera, no ground, up to 50 million triangles and
+    /// [`MAX_TEXTURE_BYTES`] of textures.
     fn default() -> Self {
-        Self { size: (640, 480), camera_index: None, ground: None, max_triangles: 50_000_000 }
+        Self {
+            size: (640, 480),
+            camera_index: None,
+            ground: None,
+            max_triangles: 50_000_000,
+            max_texture_bytes: MAX_TEXTURE_BYTES,
+        }
     }
 }
 
@@ -166,7 +191,22 @@ pub fn load_gltf_from_bytes(bytes: &[u8], path: &Path, options: &GltfOptions) ->
         }
     }
     let buffers = gltf::import_buffers(&document, path.parent(), blob).map_err(invalid)?;
-    Importer { path, options, buffers: &buffers, warnings: BTreeSet::new(), degenerate: 0, skipped: 0 }.run(&document)
+    Importer {
+        path,
+        options,
+        buffers: &buffers,
+        warnings: BTreeSet::new(),
+        degenerate: 0,
+        skipped: 0,
+        textures: Vec::new(),
+        texture_index: BTreeMap::new(),
+        texture_bytes: 0,
+        // the image's fields as written: `gltf::Image::source` unwraps a missing URI or MIME
+        // type (1.4.1), so the import reads them itself
+        images: document.as_json().images.iter().map(|i| (i.buffer_view.map(|v| v.value()), i.uri.clone())).collect(),
+        views: document.views().map(|v| (v.buffer().index(), v.offset(), v.length())).collect(),
+    }
+    .run(&document)
 }
 
 /// What the `gltf` crate (1.4) panics on instead of refusing, found by `cargo xtask fuzz`: a GLB
@@ -235,6 +275,13 @@ struct Importer<'a> {
     warnings: BTreeSet<String>,
     degenerate: usize,
     skipped: usize,
+    /// decoded textures, and which glTF texture (with its colour space) each one is
+    textures: Vec<Texture>,
+    texture_index: BTreeMap<usize, u32>,
+    texture_bytes: u64,
+    /// per image: its buffer view and URI; per buffer view: buffer, offset, length
+    images: Vec<(Option<usize>, Option<String>)>,
+    views: Vec<(usize, usize, usize)>,
 }
 
 impl Importer<'_> {
@@ -244,7 +291,7 @@ impl Importer<'_> {
 
     fn run(mut self, document: &gltf::Document) -> Result<GltfImport, GltfError> {
         for ext in document.extensions_used() {
-            if !matches!(ext, "KHR_lights_punctual") {
+            if !matches!(ext, "KHR_lights_punctual" | "KHR_materials_emissive_strength") {
                 self.warnings.insert(format!("extension {ext} is not modelled"));
             }
         }
@@ -332,7 +379,7 @@ impl Importer<'_> {
             warnings.push(format!("{} point or line primitives are not drawn", self.skipped));
         }
         Ok(GltfImport {
-            scene: Scene { name, objects, camera, point_lights },
+            scene: Scene { name, objects, camera, point_lights, textures: self.textures },
             warnings,
             degenerate: self.degenerate,
             skipped_primitives: self.skipped,
@@ -384,6 +431,26 @@ impl Importer<'_> {
             });
         }
         Ok((&data[accessor.offset()..], stride, count))
+    }
+
+    /// TEXCOORD values: floats, or unsigned bytes or shorts normalized to [0, 1].
+    fn vec2s(&self, accessor: &gltf::Accessor, what: &str) -> Result<Vec<Vec2>, GltfError> {
+        let kind = accessor.data_type();
+        if accessor.dimensions() != Dimensions::Vec2 || !matches!(kind, DataType::F32 | DataType::U8 | DataType::U16) {
+            return Err(self.malformed(format!("{what}: TEXCOORD_0 accessor {} is not VEC2", accessor.index())));
+        }
+        let (data, stride, count) = self.accessor(accessor, what)?;
+        Ok((0..count)
+            .map(|i| {
+                let e = &data[i * stride..];
+                let c = |k: usize| match kind {
+                    DataType::U8 => f32::from(e[k]) / 255.0,
+                    DataType::U16 => f32::from(u16::from_le_bytes([e[2 * k], e[2 * k + 1]])) / 65535.0,
+                    _ => f32::from_le_bytes([e[4 * k], e[4 * k + 1], e[4 * k + 2], e[4 * k + 3]]),
+                };
+                Vec2::new(c(0), c(1))
+            })
+            .collect())
     }
 
     fn vec3s(&self, accessor: &gltf::Accessor, what: &str) -> Result<Vec<Vec3>, GltfError> {
@@ -460,6 +527,21 @@ impl Importer<'_> {
             }
             None => None,
         };
+        let uvs = match primitive.get(&gltf::Semantic::TexCoords(0)) {
+            Some(a) => {
+                let uvs = self.vec2s(&a, &what)?;
+                if uvs.len() != local.len() {
+                    return Err(self.malformed(format!(
+                        "{what}: {} texture coordinates for {} positions",
+                        uvs.len(),
+                        local.len()
+                    )));
+                }
+                // a broken coordinate reads the texture's first texel, not a NaN
+                Some(uvs.into_iter().map(|v| if v.is_finite() { v } else { Vec2::ZERO }).collect::<Vec<_>>())
+            }
+            None => None,
+        };
         let list: Vec<u32> = match primitive.indices() {
             Some(a) => self.indices(&a, &what)?,
             None => (0..local.len() as u32).collect(),
@@ -501,7 +583,16 @@ impl Importer<'_> {
             return Ok(None);
         }
         *triangles += indices.len();
-        let mut mesh_out = Mesh { positions: local, normals: None, indices };
+        let material = self.material(&primitive.material())?;
+        let textured = material.maps.is_some_and(|m| {
+            m.base_color_texture.is_some() || m.metallic_roughness_texture.is_some() || m.emissive_texture.is_some()
+        });
+        if textured && uvs.is_none() {
+            self.warnings.insert("textured primitives without TEXCOORD_0 read their textures at uv (0, 0)".into());
+        }
+        // coordinates only where a texture reads them
+        let uvs = uvs.filter(|_| textured);
+        let mut mesh_out = Mesh { positions: local, normals: None, indices, uvs };
         if let Some(n) = normals {
             let m = crate::normal_matrix(glam::Mat3::from_mat4(*world));
             // a normal already unit under an identity transform is kept as written, bit for bit
@@ -520,37 +611,146 @@ impl Importer<'_> {
         Ok(Some(Object {
             name: format!("{}/{}", mesh.name().unwrap_or("mesh"), primitive.index()),
             mesh: mesh_out,
-            material: self.material(&primitive.material()),
+            material,
         }))
     }
 
-    fn material(&mut self, m: &gltf::Material) -> Material {
+    fn material(&mut self, m: &gltf::Material) -> Result<Material, GltfError> {
         let pbr = m.pbr_metallic_roughness();
         let c = pbr.base_color_factor();
-        if pbr.base_color_texture().is_some() || pbr.metallic_roughness_texture().is_some() {
-            self.warnings.insert("textures are not modelled yet: their factors are used".into());
-        }
         if m.normal_texture().is_some() || m.occlusion_texture().is_some() {
             self.warnings.insert("normal and occlusion maps are not modelled".into());
         }
-        if m.emissive_factor() != [0.0; 3] || m.emissive_texture().is_some() {
-            self.warnings.insert("emission is not modelled yet".into());
+        match m.alpha_mode() {
+            gltf::material::AlphaMode::Blend => {
+                self.warnings.insert("alpha blending is not modelled: blended surfaces are opaque".into());
+            }
+            gltf::material::AlphaMode::Mask => {
+                self.warnings.insert("alpha masks are not modelled: masked surfaces are opaque".into());
+            }
+            gltf::material::AlphaMode::Opaque => {}
         }
-        if m.alpha_mode() == gltf::material::AlphaMode::Blend {
-            self.warnings.insert("alpha blending is not modelled: blended surfaces are opaque".into());
-        }
-        if pbr.metallic_factor() > 0.0 {
-            self.warnings.insert("metallic and roughness are not modelled yet: surfaces are Lambertian".into());
-        }
-        // a GGX layer as envshadow writes it
-        let specular = ours(m.extras()).and_then(|x| {
+        let base = Vec3::new(c[0], c[1], c[2]).clamp(Vec3::ZERO, Vec3::ONE);
+        let emissive = Vec3::from(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0);
+        let emissive = if emissive.is_finite() { emissive.max(Vec3::ZERO) } else { Vec3::ZERO };
+        // what envshadow wrote, where it agrees with the standard fields (metallic 0)
+        let exact = ours(m.extras()).filter(|_| pbr.metallic_factor() == 0.0).and_then(|x| {
+            if x.get("lambert").and_then(Value::as_bool) == Some(true) {
+                return Some(None);
+            }
             let g = x.get("ggx")?;
             let roughness = g.get("roughness")?.as_f64()? as f32;
             let f0 = vec3_of(g.get("f0")?)?;
             (roughness > 0.0 && roughness <= 1.0 && f0.cmpge(Vec3::ZERO).all() && f0.cmple(Vec3::ONE).all())
-                .then_some(Ggx { roughness, f0 })
+                .then_some(Some(Ggx { roughness, f0 }))
         });
-        Material { albedo: Vec3::new(c[0], c[1], c[2]).clamp(Vec3::ZERO, Vec3::ONE), specular }
+        let base_tex = pbr.base_color_texture().map(|t| (t.texture(), t.tex_coord()));
+        let mr_tex = pbr.metallic_roughness_texture().map(|t| (t.texture(), t.tex_coord()));
+        let emissive_tex = m.emissive_texture().map(|t| (t.texture(), t.tex_coord()));
+        let mut material = match exact {
+            Some(specular) => Material::rgb(base, specular),
+            None => {
+                let (albedo, ggx) = Material::metallic_roughness(base, pbr.metallic_factor(), pbr.roughness_factor());
+                Material::rgb(albedo, Some(ggx))
+            }
+        };
+        material.emission = emissive;
+        material.double_sided = m.double_sided();
+        if base_tex.is_some() || mr_tex.is_some() || emissive_tex.is_some() {
+            let mut load = |t: Option<(gltf::Texture, u32)>| -> Result<Option<u32>, GltfError> {
+                let Some((texture, set)) = t else { return Ok(None) };
+                if set != 0 {
+                    self.warnings
+                        .insert("texture coordinate sets past TEXCOORD_0 are not modelled: TEXCOORD_0 is used".into());
+                }
+                self.texture(&texture).map(Some)
+            };
+            let maps = Maps {
+                base_color: base,
+                metallic: pbr.metallic_factor(),
+                roughness: pbr.roughness_factor(),
+                emissive,
+                base_color_texture: load(base_tex)?,
+                metallic_roughness_texture: load(mr_tex)?,
+                emissive_texture: load(emissive_tex)?,
+            };
+            material.maps = Some(maps);
+        }
+        Ok(material)
+    }
+
+    /// glTF texture `texture`, decoded once (8-bit RGBA) and kept in the scene; its index there.
+    fn texture(&mut self, texture: &gltf::Texture) -> Result<u32, GltfError> {
+        if let Some(&k) = self.texture_index.get(&texture.index()) {
+            return Ok(k);
+        }
+        let image = texture.source();
+        let what = format!("texture {} (image {})", texture.index(), image.index());
+        let (view, uri) = self.images.get(image.index()).cloned().unwrap_or_default();
+        let bytes: std::borrow::Cow<[u8]> = match (view, uri) {
+            (Some(v), _) => {
+                let Some(&(b, start, len)) = self.views.get(v) else {
+                    return Err(
+                        self.malformed(format!("{what}: buffer view {v} is past the file's {}", self.views.len()))
+                    );
+                };
+                let buffer = self.buffers.get(b).map_or(&[][..], |b| &b[..]);
+                let Some(bytes) = start.checked_add(len).and_then(|end| buffer.get(start..end)) else {
+                    return Err(self.malformed(format!(
+                        "{what}: buffer view {v} ({start} + {len} bytes) runs past its buffer of {} bytes",
+                        buffer.len()
+                    )));
+                };
+                bytes.into()
+            }
+            (None, None) => return Err(self.malformed(format!("{what}: neither a URI nor a buffer view"))),
+            (None, Some(uri)) => {
+                if let Some(data) = uri.strip_prefix("data:") {
+                    let Some((_, encoded)) = data.split_once(";base64,") else {
+                        return Err(self.malformed(format!("{what}: a data URI that is not base64")));
+                    };
+                    base64::decode(encoded)
+                        .map_err(|e| self.malformed(format!("{what}: its data URI is not base64: {e}")))?
+                        .into()
+                } else {
+                    let file = self.path.parent().unwrap_or(Path::new(".")).join(&uri);
+                    let io = |e: std::io::Error| self.malformed(format!("{what}: file {uri:?}: {e}"));
+                    let len = std::fs::metadata(&file).map_err(io)?.len();
+                    if len > MAX_FILE_BYTES {
+                        return Err(
+                            self.malformed(format!("{what}: file {uri:?} has {len} bytes, more than {MAX_FILE_BYTES}"))
+                        );
+                    }
+                    std::fs::read(&file).map_err(io)?.into()
+                }
+            }
+        };
+        let limit = self.options.max_texture_bytes;
+        let decoded = decode_image(&bytes, limit.saturating_sub(self.texture_bytes), limit)
+            .map_err(|reason| self.malformed(format!("{what}: {reason}")))?;
+        self.texture_bytes += u64::from(decoded.width()) * u64::from(decoded.height()) * 4;
+        let sampler = texture.sampler();
+        let wrap = |w: gltf::texture::WrappingMode| match w {
+            gltf::texture::WrappingMode::ClampToEdge => Wrap::Clamp,
+            gltf::texture::WrappingMode::MirroredRepeat => Wrap::Mirror,
+            gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
+        };
+        let filter = match sampler.mag_filter() {
+            Some(gltf::texture::MagFilter::Nearest) => Filter::Nearest,
+            _ => Filter::Linear,
+        };
+        let (width, height) = decoded.dimensions();
+        let texels = decoded.pixels().map(|p| p.0).collect();
+        self.textures.push(Texture {
+            width,
+            height,
+            texels,
+            wrap: [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())],
+            filter,
+        });
+        let k = self.textures.len() as u32 - 1;
+        self.texture_index.insert(texture.index(), k);
+        Ok(k)
     }
 
     fn camera(&mut self, cameras: &[(gltf::Camera, Mat4)], lo: Vec3, hi: Vec3) -> Result<Camera, GltfError> {
@@ -599,6 +799,39 @@ impl Importer<'_> {
         }
         Ok(framing_camera(lo, hi, (width, height)))
     }
+}
+
+/// A PNG or JPEG as 8-bit RGBA, its size checked before decoding: at most
+/// [`MAX_TEXTURE_SIDE`] a side and `budget` bytes of texels (what is left of `limit`).
+fn decode_image(bytes: &[u8], budget: u64, limit: u64) -> Result<image::RgbaImage, String> {
+    let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| format!("unreadable image: {e}"))?;
+    if !matches!(reader.format(), Some(image::ImageFormat::Png | image::ImageFormat::Jpeg)) {
+        return Err("not a PNG or JPEG image (the formats glTF 2.0 allows)".into());
+    }
+    let (w, h) = reader.into_dimensions().map_err(|e| format!("unreadable image: {}", one_line(&e)))?;
+    if w > MAX_TEXTURE_SIDE || h > MAX_TEXTURE_SIDE {
+        return Err(format!("{w} x {h} texels, more than the {MAX_TEXTURE_SIDE} a side a texture may have"));
+    }
+    let need = u64::from(w) * u64::from(h) * 4;
+    if need > budget {
+        return Err(format!("{w} x {h} texels would pass the {limit} bytes the textures may take"));
+    }
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| format!("unreadable image: {e}"))?;
+    let mut limits = image::Limits::default();
+    // the decoder's own buffers beside the texels
+    limits.max_alloc = Some(need.saturating_mul(3).max(1 << 20));
+    reader.limits(limits);
+    let image = reader.decode().map_err(|e| format!("unreadable image: {}", one_line(&e)))?;
+    Ok(image.into_rgba8())
+}
+
+/// A decoder's message on one line: control characters (from the file) become spaces.
+fn one_line(e: &impl std::fmt::Display) -> String {
+    e.to_string().chars().map(|c| if c.is_control() { ' ' } else { c }).collect()
 }
 
 /// `name`, or `name #2`, `name #3` … where it is taken.
@@ -657,7 +890,7 @@ fn ground(lo: Vec3, hi: Vec3, albedo: f32) -> Object {
     ];
     Object {
         name: "ground".into(),
-        mesh: Mesh { positions, normals: None, indices: vec![[0, 1, 2], [0, 2, 3]] },
+        mesh: Mesh { positions, normals: None, indices: vec![[0, 1, 2], [0, 2, 3]], uvs: None },
         material: Material::lambert(albedo.clamp(0.0, 1.0)),
     }
 }

@@ -18,14 +18,16 @@ mod light;
 mod material;
 mod mesh;
 mod obj;
+pub mod texture;
 mod visibility;
 
 pub use builtin::BUILTIN_SCENES;
 pub use camera::{Camera, CameraRays};
 pub use export::glb_bytes;
 pub use light::{DistantLight, LightShape, PointLight, cone_cosine_integral};
-pub use material::{Ggx, Material};
+pub use material::{Ggx, MIN_ROUGHNESS, Maps, Material};
 pub use mesh::{Mesh, normal_matrix};
+pub use texture::{Filter, Texture, Wrap};
 pub use visibility::Visibility;
 
 /// One object: a mesh and its material.
@@ -50,6 +52,8 @@ pub struct Scene {
     pub camera: Camera,
     /// Point lights, if the scene has any.
     pub point_lights: Vec<PointLight>,
+    /// The textures the objects' [`Maps`] index (empty for the built-in scenes).
+    pub textures: Vec<Texture>,
 }
 
 /// Errors of this crate.

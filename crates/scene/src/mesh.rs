@@ -27,6 +27,8 @@ pub struct Mesh {
     pub normals: Option<Vec<Vec3>>,
     /// Triangles as vertex indices.
     pub indices: Vec<[u32; 3]>,
+    /// Per-vertex texture coordinates (glTF's TEXCOORD_0), or `None` where nothing is textured.
+    pub uvs: Option<Vec<glam::Vec2>>,
 }
 
 impl Mesh {
@@ -64,6 +66,11 @@ impl Mesh {
             if let Some(k) = normals.iter().position(|v| (v.length() - 1.0).abs() > 1e-4) {
                 return Err(format!("normal {k} is not unit length: {}", normals[k]));
             }
+        }
+        if let Some(uvs) = &self.uvs
+            && uvs.len() != n
+        {
+            return Err(format!("{} texture coordinates for {n} vertices", uvs.len()));
         }
         if let Some(k) = self.positions.iter().position(|p| !p.is_finite()) {
             return Err(format!("vertex {k} is not finite"));
@@ -146,7 +153,7 @@ impl Mesh {
                 indices.push([a, c, d]);
             }
         }
-        Self { positions, normals: None, indices }
+        Self { positions, normals: None, indices, uvs: None }
     }
 
     /// An axis-aligned box, 12 triangles, flat shaded, faces pointing out.
@@ -234,7 +241,12 @@ impl Mesh {
             }
             tris = next;
         }
-        Self { positions: dirs.iter().map(|d| center + *d * radius).collect(), normals: Some(dirs), indices: tris }
+        Self {
+            positions: dirs.iter().map(|d| center + *d * radius).collect(),
+            normals: Some(dirs),
+            indices: tris,
+            uvs: None,
+        }
     }
 
     /// A closed cylinder standing on `base` along +Y: `segments` side quads with smooth normals
@@ -271,6 +283,6 @@ impl Mesh {
                 indices.push(if normal.y > 0.0 { [centre, a, b] } else { [centre, b, a] });
             }
         }
-        Self { positions, normals: Some(normals), indices }
+        Self { positions, normals: Some(normals), indices, uvs: None }
     }
 }

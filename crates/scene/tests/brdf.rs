@@ -10,10 +10,10 @@ fn materials() -> Vec<Material> {
     let ggx = |roughness: f32, f0: f32| Some(Ggx { roughness, f0: Vec3::splat(f0) });
     vec![
         Material::lambert(0.8),
-        Material { albedo: Vec3::new(0.3, 0.7, 0.3), specular: ggx(0.6, 0.04) },
-        Material { albedo: Vec3::new(0.25, 0.35, 0.8), specular: ggx(0.3, 0.04) },
-        Material { albedo: Vec3::splat(0.2), specular: ggx(0.2, 0.5) },
-        Material { albedo: Vec3::ONE, specular: ggx(0.05, 1.0) },
+        Material::rgb(Vec3::new(0.3, 0.7, 0.3), ggx(0.6, 0.04)),
+        Material::rgb(Vec3::new(0.25, 0.35, 0.8), ggx(0.3, 0.04)),
+        Material::rgb(Vec3::splat(0.2), ggx(0.2, 0.5)),
+        Material::rgb(Vec3::ONE, ggx(0.05, 1.0)),
     ]
 }
 
@@ -147,10 +147,7 @@ fn samples_follow_the_pdf_chi_square() {
 
 #[test]
 fn no_nan_at_extremes() {
-    let ggx = |roughness: f32| Material {
-        albedo: Vec3::splat(0.5),
-        specular: Some(Ggx { roughness, f0: Vec3::splat(0.04) }),
-    };
+    let ggx = |roughness: f32| Material::rgb(Vec3::splat(0.5), Some(Ggx { roughness, f0: Vec3::splat(0.04) }));
     for m in [ggx(0.0), ggx(1e-4), ggx(1.0), Material::lambert(1.0)] {
         for wo in [Vec3::Z, dir(std::f32::consts::FRAC_PI_2, 0.0), Vec3::new(1.0, 0.0, 1e-7).normalize(), dir(0.3, 1.0)]
         {

@@ -114,7 +114,11 @@ fn a_cube_lands_where_its_node_hierarchy_puts_it() {
         assert!((b - a).cross(c - a).dot((a + b + c) / 3.0 - centre) > 0.0, "{t:?} winds inwards");
     }
     m.validate().expect("a valid mesh");
-    assert_eq!(s.objects[0].material.albedo, Vec3::ONE, "glTF's default base colour");
+    // glTF's default material: base colour 1, metallic 1, roughness 1 (a rough white metal)
+    let m = s.objects[0].material;
+    assert_eq!(m.albedo, Vec3::ZERO, "a metal has no diffuse lobe");
+    assert_eq!(m.specular, Some(scene::Ggx { roughness: 1.0, f0: Vec3::ONE }), "glTF's default material");
+    assert!(!m.double_sided, "glTF's default: one-sided");
 }
 
 #[test]

@@ -211,6 +211,7 @@ pub fn run(map: Option<&Path>, out: &Path, frames: usize, (w, h): (u32, u32)) ->
             .collect(),
         camera,
         point_lights: Vec::new(),
+        textures: Vec::new(),
     };
 
     // 4. The renderer's passes, and the toolkit's, built once.

@@ -153,6 +153,7 @@ fn wall_scene(toward: Vec3, (width, height): (u32, u32)) -> Scene {
         ],
         camera: Camera { eye: centre + Vec3::Y * eye_height, target: centre, up: along, hfov_degrees, width, height },
         point_lights: Vec::new(),
+        textures: Vec::new(),
     }
 }
 
