@@ -1,5 +1,6 @@
 //! `cargo xtask`: the project's own jobs. `validate` is the main job, `test` runs the test
-//! suite; the rest measure (trade, frame, soft-shadows, eval-lights, shafts) or fuzz. The user's
+//! suite; the rest measure (trade, frame, soft-shadows, eval-lights, shafts), fuzz, or make the README's
+//! pictures. The user's
 //! tools are the `envshadow` binary's. One module per subcommand.
 
 #![allow(clippy::print_stdout, clippy::print_stderr)]
@@ -17,6 +18,7 @@ mod eval_lights;
 mod frame;
 mod fuzz;
 mod lavapipe;
+mod pictures;
 mod shafts;
 mod soft_shadows;
 mod test;
@@ -47,6 +49,10 @@ enum Command {
     /// and write target/validate/report.html. Fails when an error exceeds
     /// validate/thresholds.json.
     Validate(validate::ValidateArgs),
+    /// The README's pictures from the current code into docs/pictures (a model with its soft
+    /// shadows on the GPU and in the reference tracer, the map with its lights); `--check`
+    /// compares new ones with those committed, within the FLIP of docs/pictures/flip.json.
+    Pictures(pictures::PicturesArgs),
     /// Run the test suite, the GPU tests on the best adapter present (lavapipe is installed
     /// first only where there is no adapter at all and we are root).
     Test {
@@ -186,6 +192,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Fuzz { cases, seed } => return fuzz::run(cases, seed),
         Command::Validate(args) => validate::run(&args),
+        Command::Pictures(args) => pictures::run(&args),
         Command::Test { adapter, args } => test::run(adapter.as_deref(), &args),
         Command::Shafts { scene, json, source_share, leaf_size, prune, out, sweep, photo } => {
             let hierarchy = shaft_hierarchy::Settings { leaf_size, prune_fraction: prune, distant_reach: None };

@@ -31,7 +31,7 @@ pub enum EnvMapError {
     Decode {
         /// The file.
         path: PathBuf,
-        /// "OpenEXR" or "Radiance HDR".
+        /// "OpenEXR", "Radiance HDR" or "PNG".
         format: &'static str,
         /// The decoder's reason.
         reason: String,

@@ -261,6 +261,20 @@ pub fn save_png_srgb8(path: &Path, width: u32, height: u32, bytes: &[u8]) -> Res
     std::fs::write(path, png).map_err(|e| EnvMapError::io(path, e))
 }
 
+/// Reads back an 8-bit PNG as [`save_png_srgb8`] writes one: its size and row-major RGB
+/// triples (alpha dropped), for comparing committed pictures with new ones.
+///
+/// # Errors
+/// [`EnvMapError::Io`]; [`EnvMapError::Decode`] for a file that is not a PNG.
+pub fn load_png_srgb8(path: &Path) -> Result<(u32, u32, Vec<[u8; 3]>), EnvMapError> {
+    let bytes = std::fs::read(path).map_err(|e| EnvMapError::io(path, e))?;
+    let decode = |reason: String| EnvMapError::Decode { path: path.to_path_buf(), format: "PNG", reason };
+    let image = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
+        .map_err(|e| decode(crate::error::one_line(&e.to_string())))?
+        .into_rgb8();
+    Ok((image.width(), image.height(), image.pixels().map(|p| p.0).collect()))
+}
+
 /// Encodes row-major 8-bit sRGB triples as PNG file bytes in memory (for embedding, e.g. in an
 /// HTML report). Errors name no file.
 ///
