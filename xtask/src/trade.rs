@@ -49,6 +49,10 @@ pub struct TradeArgs {
     /// Frames timed per setting (the median is kept; under 3, an untimed frame goes first).
     #[arg(long)]
     repeats: Option<u32>,
+    /// Samples per pixel of the environment-lit and point-light truths (the preset's when
+    /// absent: 64 quick, 128 default); more lowers the truth's own noise under the errors.
+    #[arg(long)]
+    truth_spp: Option<u32>,
     /// This run's share of the work, I/N (0-based): the maps (each with every environment-lit
     /// scene) and the point-light and composite scenes, sorted by name, dealt round-robin.
     #[arg(long, default_value = "0/1")]
@@ -185,6 +189,9 @@ pub fn run(args: &TradeArgs) -> Result<(), String> {
     }
     if let Some(r) = args.repeats {
         plan.repeats = r.max(1);
+    }
+    if let Some(spp) = args.truth_spp {
+        plan.truth_spp = spp.max(1);
     }
     let settings = preset.settings();
     let scenes: Vec<String> = match (args.scenes.is_empty(), args.quick) {
