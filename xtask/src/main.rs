@@ -17,6 +17,7 @@ mod common;
 mod eval_lights;
 mod frame;
 mod fuzz;
+mod large_model;
 mod lavapipe;
 mod pictures;
 mod shafts;
@@ -50,9 +51,13 @@ enum Command {
     /// validate/thresholds.json.
     Validate(validate::ValidateArgs),
     /// The README's pictures from the current code into docs/pictures (a model with its soft
-    /// shadows on the GPU and in the reference tracer, the map with its lights); `--check`
-    /// compares new ones with those committed, within the FLIP of docs/pictures/flip.json.
+    /// shadows on the GPU and in the reference tracer, the map with its lights, the trade's
+    /// plot); `--check` compares new ones with those committed, within the FLIP (and the trade's
+    /// relative error) of docs/pictures/flip.json.
     Pictures(pictures::PicturesArgs),
+    /// The large model the scale figures are measured on: a grid of --triangles (2 million by
+    /// default) displaced by two sines, written as .glb or .gltf.
+    LargeModel(large_model::LargeModelArgs),
     /// Run the test suite, the GPU tests on the best adapter present (lavapipe is installed
     /// first only where there is no adapter at all and we are root).
     Test {
@@ -193,6 +198,7 @@ fn main() -> ExitCode {
         Command::Fuzz { cases, seed } => return fuzz::run(cases, seed),
         Command::Validate(args) => validate::run(&args),
         Command::Pictures(args) => pictures::run(&args),
+        Command::LargeModel(args) => large_model::run(&args),
         Command::Test { adapter, args } => test::run(adapter.as_deref(), &args),
         Command::Shafts { scene, json, source_share, leaf_size, prune, out, sweep, photo } => {
             let hierarchy = shaft_hierarchy::Settings { leaf_size, prune_fraction: prune, distant_reach: None };
