@@ -1,10 +1,9 @@
 //! The public sample models in `assets/models/` (Khronos glTF-Sample-Assets, CC0 and CC-BY 4.0;
-//! see its README): each imports with the triangles an independent reading of the file gives —
-//! the JSON through `serde_json`, the buffers' data URIs through `base64`, the node's TRS applied
-//! here — or is refused with the reason the README states, and what it holds that is not modelled
-//! is reported.
+//! see its README): each imports with its triangles, material and warnings, or is refused with
+//! the reason the README states. Their triangles and depth images against an independent reader
+//! are checked in `tests/tests/independent_gltf.rs` (it needs the reference tracer).
 
-use glam::{Quat, Vec3};
+use glam::Vec3;
 use scene::import::{GltfError, GltfOptions, load_gltf};
 use serde_json::Value;
 use std::path::PathBuf;
@@ -13,72 +12,8 @@ fn model(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../assets/models").join(name)
 }
 
-/// World-space triangles of a file of single-primitive meshes on root nodes with TRS, read
-/// without the `gltf` crate.
-fn independent_triangles(name: &str) -> Vec<[Vec3; 3]> {
-    let doc: Value = serde_json::from_slice(&std::fs::read(model(name)).expect("read")).expect("json");
-    let buffers: Vec<Vec<u8>> = doc["buffers"]
-        .as_array()
-        .expect("buffers")
-        .iter()
-        .map(|b| {
-            let uri = b["uri"].as_str().expect("uri");
-            base64::decode(&uri[uri.find(',').expect("data uri") + 1..]).expect("base64")
-        })
-        .collect();
-    let view_bytes = |accessor: &Value| -> &[u8] {
-        let view = &doc["bufferViews"][accessor["bufferView"].as_u64().expect("view") as usize];
-        let start = view["byteOffset"].as_u64().unwrap_or(0) + accessor["byteOffset"].as_u64().unwrap_or(0);
-        &buffers[view["buffer"].as_u64().expect("buffer") as usize][start as usize..]
-    };
-    let mut out = Vec::new();
-    for node in doc["scenes"][0]["nodes"].as_array().expect("nodes") {
-        let node = &doc["nodes"][node.as_u64().expect("node") as usize];
-        let Some(mesh) = node["mesh"].as_u64() else { continue };
-        let r: Vec<f32> = node["rotation"]
-            .as_array()
-            .map_or(vec![0.0, 0.0, 0.0, 1.0], |r| r.iter().map(|v| v.as_f64().expect("f") as f32).collect());
-        // the file's quaternion is unit to 3 digits (-0.383, 0.92375): a reader normalizes it
-        let rotation = Quat::from_xyzw(r[0], r[1], r[2], r[3]).normalize();
-        let primitive = &doc["meshes"][mesh as usize]["primitives"][0];
-        let positions = &doc["accessors"][primitive["attributes"]["POSITION"].as_u64().expect("pos") as usize];
-        let bytes = view_bytes(positions);
-        let f = |k: usize| f32::from_le_bytes(bytes[4 * k..4 * k + 4].try_into().expect("4 bytes"));
-        let count = positions["count"].as_u64().expect("count") as usize;
-        let p: Vec<Vec3> = (0..count).map(|v| rotation * Vec3::new(f(3 * v), f(3 * v + 1), f(3 * v + 2))).collect();
-        let indices: Vec<usize> = match primitive["indices"].as_u64() {
-            Some(k) => {
-                let a = &doc["accessors"][k as usize];
-                assert_eq!(a["componentType"], 5123, "u16 indices in these files");
-                let b = view_bytes(a);
-                (0..a["count"].as_u64().expect("count") as usize)
-                    .map(|i| u16::from_le_bytes([b[2 * i], b[2 * i + 1]]) as usize)
-                    .collect()
-            }
-            None => (0..count).collect(),
-        };
-        out.extend(indices.chunks_exact(3).map(|t| [p[t[0]], p[t[1]], p[t[2]]]));
-    }
-    out
-}
-
-fn imported_triangles(import: &scene::import::GltfImport) -> Vec<[Vec3; 3]> {
-    let mut out = Vec::new();
-    for o in &import.scene.objects {
-        out.extend(o.mesh.indices.iter().map(|t| t.map(|i| o.mesh.positions[i as usize])));
-    }
-    out
-}
-
-/// Whether two triangle lists are the same triangles, each up to a rotation of its corners (to
-/// 1e-5: a rotation through a quaternion or through a matrix rounds differently in f32).
-fn same_triangles(a: &[[Vec3; 3]], b: &[[Vec3; 3]]) -> bool {
-    let same = |x: &[Vec3; 3], y: &[Vec3; 3]| (0..3).any(|s| (0..3).all(|k| x[k].distance(y[(k + s) % 3]) < 1e-5));
-    a.len() == b.len() && a.iter().all(|t| b.iter().any(|u| same(t, u)))
-}
-
 #[test]
-fn sample_models_import_as_an_independent_reading_of_them_gives() {
+fn sample_models_import_with_their_triangles_material_and_warnings() {
     // none has a material: glTF's default (metallic 1, roughness 1, one-sided) is modelled
     for (name, triangles, warnings) in [
         ("Cameras.gltf", 2, &[][..]),
@@ -86,9 +21,8 @@ fn sample_models_import_as_an_independent_reading_of_them_gives() {
         ("AnimatedTriangle.gltf", 1, &["animations are not modelled"][..]),
     ] {
         let import = load_gltf(&model(name), &GltfOptions::default()).unwrap_or_else(|e| panic!("{e}"));
-        let (ours, theirs) = (imported_triangles(&import), independent_triangles(name));
-        assert_eq!(ours.len(), triangles, "{name}");
-        assert!(same_triangles(&ours, &theirs), "{name}: {ours:?} != {theirs:?}");
+        let count: usize = import.scene.objects.iter().map(|o| o.mesh.indices.len()).sum();
+        assert_eq!(count, triangles, "{name}");
         assert_eq!(import.warnings.len(), warnings.len(), "{name}: {:?}", import.warnings);
         for o in &import.scene.objects {
             let m = o.material;
