@@ -418,3 +418,28 @@ fn trade_writes_its_three_files_and_merges_them_back() {
     assert_eq!(o.status.code(), Some(2), "clap refuses a bad shard");
     assert!(String::from_utf8_lossy(&o.stderr).contains("I/N"));
 }
+
+#[test]
+fn large_model_writes_the_grid_it_names_and_refuses_past_its_limit() {
+    let dir = fresh_dir("cli-large-model");
+    let out = dir.join("terrain.glb");
+    let run = xtask(&["large-model", "--triangles", "20000", "--out", out.to_str().unwrap_or_default()]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    // read back through the importer every command uses: a 100 x 100 grid, all of it under
+    // the 10 m square and within the displacement's amplitude (0.6 + 0.15)
+    let options = scene::import::GltfOptions::default();
+    let (model, warnings) = scene::Scene::open(out.to_str().unwrap_or_default(), &options).expect("import");
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert_eq!(model.triangle_count(), 20_000);
+    for o in &model.objects {
+        assert_eq!(o.mesh.positions.len(), 101 * 101);
+        for p in &o.mesh.positions {
+            assert!(p.x.abs() <= 5.0 + 1e-5 && p.z.abs() <= 5.0 + 1e-5 && p.y.abs() <= 0.75 + 1e-5, "{p}");
+        }
+    }
+    let refused = xtask(&["large-model", "--triangles", "300000000", "--out", out.to_str().unwrap_or_default()]);
+    assert_eq!(refused.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(err.contains("--triangles 300000000"), "{err}");
+}
