@@ -37,6 +37,11 @@ pub struct FrameStats {
     pub gpu_ms: Option<f64>,
     /// Wall time until the frame's work is done.
     pub wall_ms: f64,
+    /// The first, unmeasured frame's wall time: pipelines compile and buffers grow on it, so
+    /// it is what a viewer waits for before its first picture.
+    pub first_frame_wall_ms: f64,
+    /// The first frame's GPU time (timestamps), `None` without timestamp queries.
+    pub first_frame_gpu_ms: Option<f64>,
 }
 
 /// Resources created in a frame (medians).
@@ -124,6 +129,7 @@ pub fn measure_frames<E: From<GpuError>>(
     let mut gates = Vec::new();
     let (mut buffers, mut binds, mut textures) = (Vec::new(), Vec::new(), Vec::new());
     let mut pipelines_after_first = 0;
+    let (mut first_wall, mut first_gpu) = (0.0, None);
     for k in 0..=frames {
         if let Some(s) = &stamps {
             s.stamp(gpu, 0);
@@ -139,6 +145,7 @@ pub fn measure_frames<E: From<GpuError>>(
         }
         let ms = stamps.as_ref().map(|s| s.read(gpu)).transpose()?;
         if k == 0 {
+            (first_wall, first_gpu) = (elapsed.as_secs_f64() * 1e3, ms);
             continue;
         }
         pipelines_after_first += d.pipelines;
@@ -164,5 +171,7 @@ pub fn measure_frames<E: From<GpuError>>(
         cpu_record_ms: median(cpu),
         gpu_ms: (!gpu_ms.is_empty()).then(|| median(gpu_ms)),
         wall_ms: median(wall),
+        first_frame_wall_ms: first_wall,
+        first_frame_gpu_ms: first_gpu,
     })
 }

@@ -44,7 +44,9 @@ pub fn run(args: &FrameArgs) -> Result<(), String> {
     }
     let map = crate::common::load_map(args.envmap).map_err(|e| e.to_string())?;
     let scene = crate::common::open_scene(args.scene, args.size, args.ground)?;
+    let setup = std::time::Instant::now();
     let mut frame = Frame::with_scene(&gpu, scene, &map, args.lights)?;
+    let setup_ms = setup.elapsed().as_secs_f64() * 1e3;
     let moving = args.animate.then(|| animated_object(&frame.scene));
     let d = &frame.decomposition;
     let (lights, directs) = (d.lights.len(), d.directs());
@@ -87,6 +89,7 @@ pub fn run(args: &FrameArgs) -> Result<(), String> {
         if args.json {
             let mut v = json(args, &gpu, &stats, moving.map(|k| frame.scene.objects[k].name.as_str()), lights);
             v["triangles"] = frame.scene.triangle_count().into();
+            v["setup_ms"] = setup_ms.into();
             v["lights_shadowed"] = (reports.len() - skipped.iter().map(|(_, n)| n).sum::<usize>()).into();
             v["lights_skipped"] = skipped.iter().map(|(why, n)| serde_json::json!({"why": why, "lights": n})).collect();
             outln!("{v}");
@@ -105,6 +108,16 @@ pub fn run(args: &FrameArgs) -> Result<(), String> {
                 stats.cpu_record_ms,
                 stats.gpu_ms.map_or(String::new(), |g| format!(", {g:.2} ms GPU (timestamps)")),
                 stats.pipelines_created_after_first_frame,
+            );
+            outln!(
+                "  EnvIndirects at {name} resolution: first frame {:.2} ms{} (pipelines compile, buffers grow){}",
+                stats.first_frame_wall_ms,
+                stats.first_frame_gpu_ms.map_or(String::new(), |g| format!(", {g:.2} ms GPU")),
+                if name == "full" {
+                    format!("; setup {setup_ms:.0} ms (decomposition, BVH and buffers)")
+                } else {
+                    String::new()
+                },
             );
         }
     }
@@ -130,6 +143,8 @@ fn json(args: &FrameArgs, gpu: &gpu::Gpu, s: &FrameStats, moving: Option<&str>, 
         "cpu_record_ms": s.cpu_record_ms,
         "gpu_ms": s.gpu_ms,
         "wall_ms": s.wall_ms,
+        "first_frame_wall_ms": s.first_frame_wall_ms,
+        "first_frame_gpu_ms": s.first_frame_gpu_ms,
         "adapter": gpu.describe(),
     })
 }

@@ -3,8 +3,8 @@
 //! Unit, integration and doc tests of every crate (the GPU ones on the best adapter present, or
 //! the one `--adapter` names; lavapipe where there is no GPU), one smoke run of every criterion
 //! bench (so benches never rot), and — when no test filter is given — the main job, `cargo xtask
-//! validate` with its defaults and thresholds, checking that the README's validate figures are
-//! this code's. Prints the wall time.
+//! validate` with its defaults and thresholds, checking that docs/measured.md's validate figures
+//! are this code's. Prints the wall time.
 
 use std::process::Command;
 use std::time::Instant;
@@ -33,8 +33,8 @@ pub fn run(adapter: Option<&str>, extra: &[String]) -> Result<(), String> {
         }
     }
     if extra.is_empty() {
-        // the main job with its defaults, as a user runs it, and the README's figures with it
-        let readme = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../README.md");
+        // the main job with its defaults, as a user runs it, and docs/measured.md's figures with it
+        let readme = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/measured.md");
         let readme = readme.to_string_lossy();
         outln!("xtask test: cargo xtask validate --check-readme {readme}");
         let mut validate = vec!["validate", "--check-readme", &readme];

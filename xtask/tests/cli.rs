@@ -150,6 +150,10 @@ fn frame_json_counts_what_a_moving_frame_costs() {
     for k in ["submits_per_frame", "waits_per_frame", "readback_bytes_per_frame", "cpu_record_ms", "wall_ms"] {
         assert!(v[k].as_f64().is_some_and(|x| x.is_finite() && x >= 0.0), "{k}: {v}");
     }
+    // the first frame does everything a measured frame does and compiles the pipelines too
+    for k in ["first_frame_wall_ms", "setup_ms"] {
+        assert!(v[k].as_f64().is_some_and(|x| x.is_finite() && x > 0.0), "{k}: {v}");
+    }
     // the recorded frame: the G-buffers' submission (with their receivers reduced) and the
     // frame's; no wait inside it, the harness's at the frame's end alone; nothing built after
     // the first frame

@@ -54,7 +54,7 @@ pub struct ValidateArgs {
     /// this binary when absent.
     #[arg(long)]
     pub thresholds: Option<PathBuf>,
-    /// Rewrite the validate block of this Markdown file (the README) with this run's figures.
+    /// Rewrite the validate block of this Markdown file (docs/measured.md) with this run's figures.
     #[arg(long)]
     pub readme: Option<PathBuf>,
     /// Fail when the validate block of this Markdown file differs from this run's figures (the
