@@ -1,6 +1,7 @@
 // requires: gpu/brdf.wgsl gpu/sh9.wgsl gpu/fullscreen.wgsl
 // Shading pass: per pixel, the G-buffer surface lit by distant cone lights (the diffuse lobe by
-// the cone's exact irradiance, a GGX lobe by its representative point) and point lights, each
+// the cone's exact irradiance, a GGX lobe by its representative point or, as wide as the cone,
+// by quadrature over it) and point lights, each
 // times its visibility layer, plus ambient: SH9 irradiance on the diffuse lobe and the
 // prefiltered ambient map on the specular lobe (both signed), as `ref-tracer`'s `lights`
 // integrator; misses see the map.
@@ -223,6 +224,18 @@ fn cone_light(m: Material, n: vec3<f32>, ng: vec3<f32>, wo: vec3<f32>, axis: vec
     let mean_cos = clamp(integral / max(solid_angle, 1e-30), 0.0, 1.0);
     let f0 = m.f0_roughness.rgb;
     var l = m.albedo.rgb * (vec3<f32>(1.0) - f0) * (28.0 / (23.0 * PI) * as_k(mean_cos) * as_k(cos_o)) * radiance * integral;
+    let alpha = max(m.f0_roughness.a * m.f0_roughness.a, MIN_ALPHA);
+    // A lobe as wide as the cone varies across it and meets the horizon inside it, which one
+    // representative point cannot follow (a fully rough metal was 14 % off at 20 degrees): such lobes
+    // integrate the cone by quadrature, sharper ones keep the point, a blend between.
+    let quad = select(clamp(2.0 * alpha / half - 1.0, 0.0, 1.0), 0.0, half < 0.05);
+    if quad > 0.0 {
+        l += cone_specular_quadrature(m, n, ng, wo, axis, cos_h, e) * quad;
+        if quad >= 1.0 {
+            return l;
+        }
+    }
+    let point = 1.0 - quad;
     // specular: the cone's direction closest to the mirror direction
     let r = reflect(-wo, n);
     var d = r;
@@ -236,7 +249,6 @@ fn cone_light(m: Material, n: vec3<f32>, ng: vec3<f32>, wo: vec3<f32>, axis: vec
     if cos_i <= 0.0 || dot(ng, d) <= 0.0 {
         return l;
     }
-    let alpha = max(m.f0_roughness.a * m.f0_roughness.a, MIN_ALPHA);
     // the lobe widened by the cone keeps its energy (Karis 2013's sphere-light normalization)
     let widened = min(alpha + 0.5 * tan(min(half, 1.5)), 1.0);
     let norm = (alpha / widened) * (alpha / widened);
@@ -244,8 +256,38 @@ fn cone_light(m: Material, n: vec3<f32>, ng: vec3<f32>, wo: vec3<f32>, axis: vec
     let h = hs / max(length(hs), 1e-30);
     let g2 = 1.0 / (1.0 + ggx_lambda(cos_o, alpha) + ggx_lambda(cos_i, alpha));
     let spec = ggx_d(dot(n, h), alpha) * g2 / (4.0 * cos_o * cos_i);
-    l += fresnel_schlick(f0, dot(wo, h)) * spec * cos_i * e * norm;
+    l += fresnel_schlick(f0, dot(wo, h)) * spec * cos_i * e * (norm * point);
     return l;
+}
+
+// The specular lobe over a cone (unit axis, cos of its half-angle, radiance x solid angle `e`)
+// by a Fibonacci spiral of equal solid angles: deterministic, so frames do not flicker, and
+// zero below the shading and the geometric horizon.
+const CONE_QUADRATURE: u32 = 16u;
+fn cone_specular_quadrature(m: Material, n: vec3<f32>, ng: vec3<f32>, wo: vec3<f32>, axis: vec3<f32>, cos_h: f32, e: vec3<f32>) -> vec3<f32> {
+    let cos_o = dot(n, wo);
+    let f0 = m.f0_roughness.rgb;
+    let alpha = max(m.f0_roughness.a * m.f0_roughness.a, MIN_ALPHA);
+    let helper = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(axis.x) > 0.9);
+    let t = normalize(cross(helper, axis));
+    let b = cross(axis, t);
+    var sum = vec3<f32>(0.0);
+    for (var k = 0u; k < CONE_QUADRATURE; k++) {
+        let c = 1.0 - (1.0 - cos_h) * (f32(k) + 0.5) / f32(CONE_QUADRATURE);
+        let s = sqrt(max(1.0 - c * c, 0.0));
+        let phi = f32(k) * 2.39996323;
+        let d = axis * c + (t * cos(phi) + b * sin(phi)) * s;
+        let cos_i = dot(n, d);
+        if cos_i <= 0.0 || dot(ng, d) <= 0.0 {
+            continue;
+        }
+        let hs = wo + d;
+        let h = hs / max(length(hs), 1e-30);
+        let g2 = 1.0 / (1.0 + ggx_lambda(cos_o, alpha) + ggx_lambda(cos_i, alpha));
+        let spec = ggx_d(dot(n, h), alpha) * g2 / (4.0 * cos_o * cos_i);
+        sum += fresnel_schlick(f0, dot(wo, h)) * (spec * cos_i);
+    }
+    return sum * e / f32(CONE_QUADRATURE);
 }
 
 @fragment

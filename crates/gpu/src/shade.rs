@@ -17,9 +17,10 @@ use wgpu::util::DeviceExt;
 pub enum ShadeLight {
     /// A distant cone light of uniform radiance: the diffuse lobe gets the cone's exact
     /// irradiance (the closed form for a uniform disk or sphere light, the part below the
-    /// surface's horizon left out), a GGX lobe its representative point (the cone's direction
-    /// closest to the mirror direction, with the lobe widened by the cone's size to keep its
-    /// energy). Half-angle 0 is a directional light.
+    /// surface's horizon left out); a GGX lobe sharper than the cone its representative point
+    /// (the cone's direction closest to the mirror direction, with the lobe widened by the
+    /// cone's size to keep its energy), a lobe as wide as the cone a 16-point quadrature of the
+    /// cone (the horizon left out), a blend between. Half-angle 0 is a directional light.
     Distant {
         /// Unit direction towards the light.
         direction: Vec3,
