@@ -1,7 +1,8 @@
 // requires: penumbra-wedge/light.wgsl penumbra-wedge/coverage.wgsl penumbra-wedge/footprint.wgsl
 // A light's shadow volume, silhouette and wedge footprints built on the GPU from the casters'
 // edges with adjacency (`penumbra_wedge::gpu_build`; the CPU builder, `Wedges::plan`, is the
-// reference it is tested against). Five dispatches a light, in order:
+// reference it is tested against). Five dispatches a light (a chunk, for a mesh built in
+// chunks: then a classify over every chunk that only marks the faces goes first), in order:
 //   classify   per face: lit as wound, lit flipped (a sheet's back), unlit (a closed mesh's),
 //              or not casting; a casting face appends its front and dark caps to the volume.
 //   mark       per undirected edge: the net count of lit faces winding it one way, the lit and
@@ -31,6 +32,14 @@ struct Build {
     // extent (how far volumes and wedges reach), near (no receiver is nearer), cull (1 or 0),
     // silhouette edges a footprint (at least 1)
     reach: vec4<f32>,
+}
+
+// The faces and edges one pass of the build covers (`gpu_build::Chunk`): a mesh too large for
+// the device's buffers is built in chunks, one after another, into the same scratch buffers.
+struct Chunk {
+    // first face, first edge, 1 when classify appends the caps (0: it only marks the faces,
+    // for the chunks whose edges read them)
+    first: vec4<u32>,
     // faces, edges, edge blocks of 256, silhouette capacity
     counts: vec4<u32>,
 }
@@ -69,6 +78,7 @@ struct Mark {
 // the footprints' dispatch (apart from `args`: a dispatch may not read its arguments from a
 // buffer it binds for writing)
 @group(0) @binding(13) var<storage, read_write> footprint_dispatch: array<u32>;
+@group(0) @binding(16) var<uniform> chunk: Chunk;
 
 const UNLIT: u32 = 0u;
 const LIT: u32 = 1u;
@@ -133,10 +143,10 @@ fn put_vertex(k: u32, p: vec3<f32>) {
 
 @compute @workgroup_size(256)
 fn classify(@builtin(global_invocation_id) id: vec3<u32>) {
-    let i = id.x;
-    if i >= build.counts.x {
+    if id.x >= chunk.counts.x {
         return;
     }
+    let i = chunk.first.x + id.x;
     let f = faces[i];
     let c = casters[f.w];
     let pa = positions[f.x].xyz;
@@ -155,7 +165,7 @@ fn classify(@builtin(global_invocation_id) id: vec3<u32>) {
         }
     }
     lit[i] = flag;
-    if flag != LIT && flag != FLIPPED {
+    if chunk.first.z == 0u || (flag != LIT && flag != FLIPPED) {
         return;
     }
     if flag == FLIPPED {
@@ -186,8 +196,8 @@ fn mark(
 ) {
     let e = id.x;
     var net = 0;
-    if e < build.counts.y {
-        let r = edges[e];
+    if e < chunk.counts.y {
+        let r = edges[chunk.first.y + e];
         var lit_sum = vec3<f32>(0.0);
         var unlit_sum = vec3<f32>(0.0);
         var caster = 0u;
@@ -232,7 +242,7 @@ fn mark(
 
 @compute @workgroup_size(256)
 fn scan(@builtin(local_invocation_index) local: u32) {
-    let n = build.counts.z;
+    let n = chunk.counts.z;
     let per = (n + 255u) / 256u;
     let first = min(local * per, n);
     let end = min(first + per, n);
@@ -243,7 +253,7 @@ fn scan(@builtin(local_invocation_index) local: u32) {
     shared_counts[local] = sum;
     workgroupBarrier();
     if local == 0u {
-        let total = min(exclusive_scan(), build.counts.w);
+        let total = min(exclusive_scan(), chunk.counts.w);
         let group = u32(build.reach.w);
         let groups = (total + group - 1u) / group;
         atomicStore(&args[1], 1u);
@@ -272,7 +282,7 @@ fn emit(
     let e = id.x;
     var m: Mark;
     var count = 0u;
-    if e < build.counts.y {
+    if e < chunk.counts.y {
         m = marks[e];
         count = u32(abs(m.net));
     }
@@ -297,7 +307,7 @@ fn emit(
     let a2 = extrude(a, len);
     let b2 = extrude(b, len);
     for (var k = 0u; k < count; k++) {
-        if at + k >= build.counts.w {
+        if at + k >= chunk.counts.w {
             return;
         }
         silhouette[at + k] = Edge(vec4<f32>(a, 1.0), vec4<f32>(b, 1.0), m.lit, m.unlit);

@@ -81,11 +81,21 @@ pub struct WedgeSettings {
     pub cosine_weighted: bool,
     /// Where the geometry is built (the raster path; the compute path builds on the CPU).
     pub build: WedgeBuild,
+    /// The largest buffer the GPU build uses for one light, bytes (`None`: the device's storage
+    /// binding limit, as the default): a mesh that needs more is built in chunks of faces and
+    /// edges, one after another, the same pixels in more passes with less memory.
+    pub chunk_bytes: Option<u64>,
+}
+
+impl WedgeSettings {
+    fn build_sizes(&self) -> gpu_build::BuildSizes {
+        gpu_build::BuildSizes { edges_per_footprint: self.edges_per_footprint, chunk_bytes: self.chunk_bytes }
+    }
 }
 
 impl Default for WedgeSettings {
     /// Culling on, 8 edges per footprint (the CPU builder's), the raster path, cosine
-    /// weighting, built on the GPU.
+    /// weighting, built on the GPU, chunked at the device's limit.
     fn default() -> Self {
         Self {
             cull: true,
@@ -93,6 +103,7 @@ impl Default for WedgeSettings {
             path: WedgePath::Raster,
             cosine_weighted: true,
             build: WedgeBuild::Gpu,
+            chunk_bytes: None,
         }
     }
 }
@@ -197,7 +208,15 @@ struct LightSlot {
     uniform: wgpu::Buffer,
     casters: wgpu::Buffer,
     view: wgpu::Buffer,
-    binds: gpu::Keyed<(wgpu::Buffer, wgpu::Texture, wgpu::Texture), [wgpu::BindGroup; 7]>,
+    binds: gpu::Keyed<(wgpu::Buffer, wgpu::Texture, wgpu::Texture), LightBinds>,
+}
+
+/// A GPU-built light's bind groups: its build's, the volume pass's and the wedge pass's.
+#[derive(Clone)]
+struct LightBinds {
+    build: gpu_build::BuildBinds,
+    volume: wgpu::BindGroup,
+    wedge: wgpu::BindGroup,
 }
 
 /// A light's screen-sized scratch targets.
@@ -371,7 +390,7 @@ impl Wedges {
             cache: None,
         });
         let no_edge_sum = edge_sum_texture(gpu, (1, 1));
-        let builder = GpuBuilder::new(gpu, &casters, settings.edges_per_footprint, LIBRARY);
+        let builder = GpuBuilder::new(gpu, &casters, settings.build_sizes(), LIBRARY);
         Self {
             casters,
             bounds: (lo, hi),
@@ -429,7 +448,7 @@ impl Wedges {
         let same = moved.triangles == slot.triangles && moved.positions.len() == slot.positions.len();
         *slot = moved;
         self.bounds = casters_bounds(&self.casters);
-        self.builder.update(gpu, &self.casters, object, same, self.settings.edges_per_footprint);
+        self.builder.update(gpu, &self.casters, object, same, self.settings.build_sizes());
         Ok(())
     }
 
@@ -448,6 +467,14 @@ impl Wedges {
         slot.transform = transform;
         self.bounds = casters_bounds(&self.casters);
         Ok(())
+    }
+
+    /// How many chunks one light's GPU build takes: 1 while the casters fit the device's
+    /// buffers (and [`WedgeSettings::chunk_bytes`]), more for larger meshes, 0 when the
+    /// casters could not be built (every light then fails with the reason).
+    #[must_use]
+    pub fn build_chunks(&self) -> usize {
+        self.builder.mesh.as_ref().map_or(0, |m| m.chunks.len())
     }
 
     /// The casters (which are closed, which cast as sheets).
@@ -553,7 +580,6 @@ struct BuildUniform {
     receivers_lo: [f32; 4],
     receivers_hi: [f32; 4],
     reach: [f32; 4],
-    counts: [u32; 4],
 }
 
 impl Wedges {
@@ -610,21 +636,23 @@ impl Wedges {
         if !self.built_on_gpu() {
             return Err(GpuError::Failed(format!("{}: not built on the GPU", self.name())));
         }
-        let mesh = self.builder.mesh.as_ref().map_err(|e| GpuError::Failed(format!("wedges: {e}")))?;
         let (w, h) = receivers.gbuffer.size();
         let vis = gpu::VisibilityLayers::new(gpu, w, h, 1)?;
         let mut encoder = gpu.encoder("silhouette");
-        self.record(gpu, &mut encoder, receivers, light, None, &vis.layer(0))?;
+        let mut kept = Vec::new();
+        self.record_built(gpu, &mut encoder, receivers, light, None, &vis.layer(0), Some(&mut kept))?;
         gpu.submit_and_wait(encoder)?;
-        let args: Vec<u32> = bytemuck::pod_collect_to_vec(&gpu::read_buffer(gpu, &mesh.args)?);
-        let edges: Vec<[[f32; 4]; 4]> = bytemuck::pod_collect_to_vec(&gpu::read_buffer(gpu, &mesh.silhouette)?);
-        let n = (args[12] as usize).min(edges.len());
         let v = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
-        Ok(casters::Silhouette {
-            edges: edges[..n].iter().map(|e| [v(e[0]), v(e[1])]).collect(),
-            normals: edges[..n].iter().map(|e| [v(e[2]), v(e[3])]).collect(),
-            lit_faces: Vec::new(),
-        })
+        let mut silhouette = casters::Silhouette { edges: Vec::new(), normals: Vec::new(), lit_faces: Vec::new() };
+        // chunk by chunk, in edge order
+        for (args, edges) in &kept {
+            let args: Vec<u32> = bytemuck::pod_collect_to_vec(&gpu::read_buffer(gpu, args)?);
+            let edges: Vec<[[f32; 4]; 4]> = bytemuck::pod_collect_to_vec(&gpu::read_buffer(gpu, edges)?);
+            let n = (args[12] as usize).min(edges.len());
+            silhouette.edges.extend(edges[..n].iter().map(|e| [v(e[0]), v(e[1])]));
+            silhouette.normals.extend(edges[..n].iter().map(|e| [v(e[2]), v(e[3])]));
+        }
+        Ok(silhouette)
     }
 
     /// Whether lights are built on the GPU: [`WedgeBuild::Gpu`] on the raster path.
@@ -632,7 +660,9 @@ impl Wedges {
         self.settings.build == WedgeBuild::Gpu && self.settings.path == WedgePath::Raster
     }
 
-    /// [`ShadowTechnique::record`] with the geometry built on the GPU (`gpu_build`).
+    /// [`ShadowTechnique::record`] with the geometry built on the GPU (`gpu_build`), chunk by
+    /// chunk; `keep` gets a copy of each chunk's arguments and silhouette (measurement).
+    #[allow(clippy::too_many_arguments)]
     fn record_built(
         &self,
         gpu: &Gpu,
@@ -641,18 +671,16 @@ impl Wedges {
         light: &LightShape,
         gate: Option<gpu::Gate<'_>>,
         target: &wgpu::TextureView,
+        mut keep: Option<&mut Vec<(wgpu::Buffer, wgpu::Buffer)>>,
     ) -> Result<ShadowPassReport, GpuError> {
         let mesh = self.builder.mesh.as_ref().map_err(|e| GpuError::Failed(format!("wedges: {e}")))?;
         let gb = receivers.gbuffer;
         let extent = self.extent(receivers.bounds);
         let view_proj = gb.view.unclipped_projection(extent * 1e-6);
-        let (params, culled, counts) = match receivers.bounds {
-            Some(rb) => {
-                let (p, culled) = self.caster_params(light, rb, extent);
-                (p, culled, GpuBuilder::counts_row(mesh))
-            }
+        let (params, culled) = match receivers.bounds {
+            Some(rb) => self.caster_params(light, rb, extent),
             // nothing visible: nothing to build
-            None => (Vec::new(), 0, [0; 4]),
+            None => (Vec::new(), 0),
         };
         let (lo, hi) = receivers.bounds.unwrap_or((Vec3::ZERO, Vec3::ZERO));
         let light_params = light_uniform(light, self.settings.cosine_weighted);
@@ -667,7 +695,6 @@ impl Wedges {
                 f32::from(u8::from(self.settings.cull)),
                 gpu_build::group_size(self.settings.edges_per_footprint) as f32,
             ],
-            counts,
         };
         let mut caster_words = params;
         // one row a caster whatever the light (culled rows stay zero), at least one
@@ -705,7 +732,7 @@ impl Wedges {
                     size: wgpu::BufferSize::new(std::mem::size_of_val(&light_params) as u64),
                 });
                 let build = LightBuild { uniform: &uniform_buf, casters: &casters_buf };
-                let [classify, mark, scan, emit, footprint] = self.builder.bind_groups(gpu, mesh, &build);
+                let build = self.builder.bind_groups(gpu, mesh, &build);
                 let position = gb.position.create_view(&Default::default());
                 let normal = gb.geometric_normal.create_view(&Default::default());
                 let volume = self.volume_bind(gpu, &view_buf, &position);
@@ -720,63 +747,107 @@ impl Wedges {
                         wgpu::BindGroupEntry { binding: 4, resource: mesh.footprints.as_entire_binding() },
                     ],
                 });
-                [classify, mark, scan, emit, footprint, volume, wedge]
+                LightBinds { build, volume, wedge }
             });
             binds.clone()
         });
-        let [classify, mark, scan, emit, footprint, volume_bind, wedge_bind] = binds;
-        let binds = [classify, mark, scan, emit, footprint];
         let scratch = self.scratch(gpu, gb.size())?;
         let acc = &scratch.accumulator;
         // moved casters' vertices first (nothing when none moved)
         mesh.record_placement(gpu, encoder);
-        // what the GPU does not write stays zero: no draw, no dispatch
-        encoder.clear_buffer(&mesh.args, 0, None);
-        encoder.clear_buffer(&mesh.footprint_dispatch, 0, None);
-        // workgroups of faces, and the edge blocks (zero when nothing is visible)
-        let (faces, edges) = (counts[0].div_ceil(gpu_build::BLOCK), counts[2]);
-        let calls = Calls::new(
-            gpu,
-            encoder,
-            gate,
-            vec![
-                Indirect::Dispatch([faces, 1, 1]),
-                Indirect::Dispatch([edges, 1, 1]),
-                Indirect::Dispatch([u32::from(edges > 0), 1, 1]),
-                Indirect::Dispatch([edges, 1, 1]),
-                Indirect::draw(0..3),
-            ],
-        );
-        {
+        // per chunk, its workgroups of faces and its edge blocks (zero when nothing is visible)
+        let visible = receivers.bounds.is_some();
+        let sizes: Vec<(u32, u32)> = mesh
+            .chunks
+            .iter()
+            .map(|c| {
+                if visible {
+                    (c.range.faces.1.div_ceil(gpu_build::BLOCK), c.range.edges.1.div_ceil(gpu_build::BLOCK))
+                } else {
+                    (0, 0)
+                }
+            })
+            .collect();
+        // chunks read faces of other chunks: every face is marked first
+        let chunked = sizes.len() > 1;
+        let mut args = Vec::new();
+        if chunked {
+            args.extend(sizes.iter().map(|&(f, _)| Indirect::Dispatch([f, 1, 1])));
+        }
+        for &(f, e) in &sizes {
+            args.extend([
+                Indirect::Dispatch([f, 1, 1]),
+                Indirect::Dispatch([e, 1, 1]),
+                Indirect::Dispatch([u32::from(e > 0), 1, 1]),
+                Indirect::Dispatch([e, 1, 1]),
+            ]);
+        }
+        args.push(Indirect::draw(0..3));
+        let resolve_call = args.len() - 1;
+        let calls = Calls::new(gpu, encoder, gate, args);
+        let mut call = 0;
+        if chunked {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("wedge build"),
+                label: Some("wedge faces"),
                 timestamp_writes: None,
             });
-            let stages = [&self.builder.classify, &self.builder.mark, &self.builder.scan, &self.builder.emit];
-            for (k, (pipeline, bind)) in stages.into_iter().zip(&binds).enumerate() {
-                pass.set_pipeline(pipeline);
-                pass.set_bind_group(0, bind, &[]);
-                calls.dispatch(&mut pass, k);
+            pass.set_pipeline(&self.builder.classify);
+            for chunk in &binds.build.chunks {
+                pass.set_bind_group(0, &chunk.mark_only, &[]);
+                calls.dispatch(&mut pass, call);
+                call += 1;
             }
-            pass.set_pipeline(&self.builder.footprint);
-            pass.set_bind_group(0, &binds[4], &[]);
-            pass.dispatch_workgroups_indirect(&mesh.footprint_dispatch, 0);
         }
-        {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("wedges"),
-                color_attachments: &[Some(acc.attachment(true))],
-                ..Default::default()
-            });
-            pass.set_pipeline(&self.volume);
-            pass.set_bind_group(0, &volume_bind, &[]);
-            pass.set_vertex_buffer(0, mesh.volume.slice(..));
-            pass.draw_indirect(&mesh.args, 0);
-            pass.set_pipeline(&self.polygons);
-            pass.set_bind_group(0, &wedge_bind, &[]);
-            pass.draw_indirect(&mesh.args, 16);
+        for (k, chunk) in binds.build.chunks.iter().enumerate() {
+            // what the GPU does not write stays zero: no draw, no dispatch
+            encoder.clear_buffer(&mesh.args, 0, None);
+            encoder.clear_buffer(&mesh.footprint_dispatch, 0, None);
+            {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("wedge build"),
+                    timestamp_writes: None,
+                });
+                let stages = [&self.builder.classify, &self.builder.mark, &self.builder.scan, &self.builder.emit];
+                for (pipeline, bind) in stages.into_iter().zip(&chunk.stages) {
+                    pass.set_pipeline(pipeline);
+                    pass.set_bind_group(0, bind, &[]);
+                    calls.dispatch(&mut pass, call);
+                    call += 1;
+                }
+                pass.set_pipeline(&self.builder.footprint);
+                pass.set_bind_group(0, &binds.build.footprint, &[]);
+                pass.dispatch_workgroups_indirect(&mesh.footprint_dispatch, 0);
+            }
+            if let Some(keep) = keep.as_deref_mut() {
+                let copy = |encoder: &mut wgpu::CommandEncoder, from: &wgpu::Buffer| {
+                    let to = gpu.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some("kept wedge build"),
+                        size: from.size(),
+                        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+                        mapped_at_creation: false,
+                    });
+                    encoder.copy_buffer_to_buffer(from, 0, &to, 0, from.size());
+                    to
+                };
+                let kept = (copy(encoder, &mesh.args), copy(encoder, &mesh.silhouette));
+                keep.push(kept);
+            }
+            {
+                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("wedges"),
+                    color_attachments: &[Some(acc.attachment(k == 0))],
+                    ..Default::default()
+                });
+                pass.set_pipeline(&self.volume);
+                pass.set_bind_group(0, &binds.volume, &[]);
+                pass.set_vertex_buffer(0, mesh.volume.slice(..));
+                pass.draw_indirect(&mesh.args, 0);
+                pass.set_pipeline(&self.polygons);
+                pass.set_bind_group(0, &binds.wedge, &[]);
+                pass.draw_indirect(&mesh.args, 16);
+            }
+            self.builder.keep_counts(encoder, mesh);
         }
-        self.builder.keep_counts(encoder, mesh);
         let extra = [(3, &gb.geometric_normal), (4, &self.no_edge_sum)];
         self.resolve.record(
             gpu,
@@ -785,7 +856,7 @@ impl Wedges {
             acc,
             bytemuck::cast_slice(&light_params),
             &extra,
-            Some((&calls, 4)),
+            Some((&calls, resolve_call)),
             target,
         )?;
         Ok(ShadowPassReport {
@@ -845,7 +916,7 @@ impl ShadowTechnique for Wedges {
         target: &wgpu::TextureView,
     ) -> Result<ShadowPassReport, GpuError> {
         if self.built_on_gpu() {
-            return self.record_built(gpu, encoder, receivers, light, gate, target);
+            return self.record_built(gpu, encoder, receivers, light, gate, target, None);
         }
         let gb = receivers.gbuffer;
         let extent = self.extent(receivers.bounds);
