@@ -1,8 +1,8 @@
 //! The glTF import against an independent reading of the same files: the JSON through
 //! `serde_json`, buffers from data URIs (`base64`) or beside the file, the default scene's node
-//! tree with its matrices and TRS applied here, u8/u16/u32 or no indices, and a ray caster of its
+//! tree with its matrices and TRS applied here, u8/u16/u32 or no indices, sparse accessors, and a ray caster of its
 //! own (every triangle against every pixel's centre ray, back faces of one-sided materials
-//! culled). Each public sample model in `assets/models/` that the import reads gives the same
+//! culled). Each public sample model in `assets/models/` gives the same
 //! world-space triangles, and the depth image the reference tracer renders of the import
 //! (`render --aovs`'s `OUT.depth.exr`) is the one cast here through the same camera, pixel for
 //! pixel.
@@ -101,12 +101,24 @@ fn independent_triangles(path: &Path) -> Vec<Triangle> {
             assert_eq!(primitive["mode"].as_u64().unwrap_or(4), 4, "triangle lists in these files");
             let positions = &doc["accessors"][primitive["attributes"]["POSITION"].as_u64().expect("pos") as usize];
             let count = positions["count"].as_u64().expect("count") as usize;
-            let p: Vec<Vec3> = (0..count)
-                .map(|v| {
-                    let c = |k| component(positions, 3 * v + k) as f32;
-                    world.transform_point3(Vec3::new(c(0), c(1), c(2)))
-                })
+            let element = |a: &Value, v: usize| Vec3::from_array([0, 1, 2].map(|k| component(a, 3 * v + k) as f32));
+            // a sparse accessor: its base (zeros without a view) with elements substituted
+            let mut local: Vec<Vec3> = (0..count)
+                .map(|v| if positions["bufferView"].is_null() { Vec3::ZERO } else { element(positions, v) })
                 .collect();
+            if let Some(sparse) = positions.get("sparse") {
+                let part = |key: &str, component_type: &Value, kind: &str| {
+                    let s = &sparse[key];
+                    serde_json::json!({ "bufferView": s["bufferView"], "byteOffset": s["byteOffset"],
+                        "componentType": component_type, "type": kind })
+                };
+                let indices = part("indices", &sparse["indices"]["componentType"], "SCALAR");
+                let values = part("values", &positions["componentType"], "VEC3");
+                for k in 0..sparse["count"].as_u64().expect("count") as usize {
+                    local[component(&indices, k) as usize] = element(&values, k);
+                }
+            }
+            let p: Vec<Vec3> = local.into_iter().map(|x| world.transform_point3(x)).collect();
             let indices: Vec<usize> = match primitive["indices"].as_u64() {
                 Some(k) => {
                     let a = &doc["accessors"][k as usize];
@@ -164,12 +176,18 @@ fn same_triangles(a: &[[Vec3; 3]], b: &[Triangle]) -> bool {
     a.len() == b.len() && a.iter().all(|t| b.iter().any(|u| same(t, &u.p)))
 }
 
-/// The sample models the import reads (SimpleSparseAccessor is refused; see its test in `scene`).
-const READ: [&str; 4] = ["Cameras.gltf", "TriangleWithoutIndices.gltf", "AnimatedTriangle.gltf", "BoxTextured.gltf"];
+/// The sample models.
+const READ: [&str; 5] = [
+    "Cameras.gltf",
+    "TriangleWithoutIndices.gltf",
+    "AnimatedTriangle.gltf",
+    "BoxTextured.gltf",
+    "SimpleSparseAccessor.gltf",
+];
 
 #[test]
 fn sample_models_import_as_an_independent_reading_of_them_gives() {
-    for (name, triangles) in READ.into_iter().zip([2, 1, 1, 12]) {
+    for (name, triangles) in READ.into_iter().zip([2, 1, 1, 12, 12]) {
         let (scene, _) = scene::Scene::open(&model(name).display().to_string(), &Default::default())
             .unwrap_or_else(|e| panic!("{e}"));
         let (ours, theirs) = (imported_triangles(&scene), independent_triangles(&model(name)));

@@ -195,8 +195,46 @@ fn handmade() -> (serde_json::Value, Vec<u8>) {
     (doc, bin)
 }
 
+/// A grid of 2 x 7 vertices whose positions substitute three sparsely (u16 indices, as
+/// SimpleSparseAccessor does), and a second primitive whose sparse positions have no view (a
+/// base of zeros). Its document and buffer.
+fn sparse() -> (serde_json::Value, Vec<u8>) {
+    let grid: Vec<[f32; 3]> = (0..14).map(|i| [(i % 7) as f32, (i / 7) as f32, 0.0]).collect();
+    let indices: Vec<u16> = (0..6u16).flat_map(|x| [x, x + 8, x + 7, x, x + 1, x + 8]).collect();
+    let mut bin: Vec<u8> = grid.iter().flatten().flat_map(|f| f.to_le_bytes()).collect();
+    bin.extend(indices.iter().flat_map(|i| i.to_le_bytes()));
+    bin.extend([8u16, 10, 12].iter().flat_map(|i| i.to_le_bytes()));
+    bin.extend([0u8; 2]);
+    bin.extend([[1.0f32, 2.0, 0.0], [3.0, 3.0, 0.0], [5.0, 4.0, 0.0]].iter().flatten().flat_map(|f| f.to_le_bytes()));
+    let sparse = serde_json::json!({"count": 3, "indices": {"bufferView": 2, "componentType": 5123},
+        "values": {"bufferView": 3}});
+    let doc = serde_json::json!({
+        "asset": {"version": "2.0", "generator": "input-fuzz"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 1}, "indices": 0},
+                                   {"attributes": {"POSITION": 2}, "indices": 0}]}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5123, "count": 36, "type": "SCALAR"},
+            {"bufferView": 1, "componentType": 5126, "count": 14, "type": "VEC3",
+             "min": [0.0, 0.0, 0.0], "max": [6.0, 4.0, 0.0], "sparse": sparse},
+            {"componentType": 5126, "count": 14, "type": "VEC3",
+             "min": [0.0, 0.0, 0.0], "max": [5.0, 4.0, 0.0], "sparse": sparse}
+        ],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 168, "byteLength": 72, "target": 34963},
+            {"buffer": 0, "byteOffset": 0, "byteLength": 168, "target": 34962},
+            {"buffer": 0, "byteOffset": 240, "byteLength": 6},
+            {"buffer": 0, "byteOffset": 248, "byteLength": 36}
+        ],
+        "buffers": [{"byteLength": bin.len()}]
+    });
+    (doc, bin)
+}
+
 /// The glTF seeds' documents and buffers: `three_boxes` and `column` as the export writes them,
-/// and [`handmade`].
+/// [`handmade`] and [`sparse`].
 fn models() -> Vec<(serde_json::Value, Vec<u8>)> {
     let mut out: Vec<_> = ["three_boxes", "column"]
         .iter()
@@ -204,6 +242,7 @@ fn models() -> Vec<(serde_json::Value, Vec<u8>)> {
         .map(|s| s.to_gltf(None))
         .collect();
     out.push(handmade());
+    out.push(sparse());
     out
 }
 

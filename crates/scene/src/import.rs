@@ -25,6 +25,7 @@ use glam::{Affine3A, Mat4, Vec2, Vec3};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 use serde_json::Value;
+use std::borrow::Cow;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
@@ -386,12 +387,8 @@ impl Importer<'_> {
         })
     }
 
-    /// The bytes of `accessor`, checked: its last element ends inside its view, its view inside
-    /// its buffer; `(data, stride, count)`.
-    fn accessor(&self, accessor: &gltf::Accessor, what: &str) -> Result<(&[u8], usize, usize), GltfError> {
-        let Some(view) = accessor.view() else {
-            return Err(self.malformed(format!("{what}: accessor {} has no buffer view", accessor.index())));
-        };
+    /// The bytes of buffer view `view`, checked to lie inside its buffer.
+    fn view(&self, view: &gltf::buffer::View, what: &str) -> Result<&[u8], GltfError> {
         let buffer = self
             .buffers
             .get(view.buffer().index())
@@ -404,10 +401,33 @@ impl Importer<'_> {
                 buffer.len()
             )));
         }
-        let data = &buffer[start..start + len];
+        Ok(&buffer[start..start + len])
+    }
+
+    /// The bytes of `accessor`, checked: its last element ends inside its view, its view inside
+    /// its buffer; `(data, stride, count)`. A sparse accessor comes back dense: its base (or
+    /// zeros, without a view) with the substituted elements written in, each index checked.
+    fn accessor(&self, accessor: &gltf::Accessor, what: &str) -> Result<(Cow<'_, [u8]>, usize, usize), GltfError> {
         let size = accessor.size();
-        let stride = view.stride().unwrap_or(size);
         let count = accessor.count();
+        let sparse = accessor.sparse();
+        let Some(view) = accessor.view() else {
+            if sparse.is_none() {
+                return Err(self.malformed(format!("{what}: accessor {} has no buffer view", accessor.index())));
+            }
+            // all zeros but the substitutions: refused past what any triangle could use
+            let limit = self.options.max_triangles.saturating_mul(3);
+            if count > limit {
+                return Err(self.malformed(format!(
+                    "{what}: sparse accessor {} of {count} elements exceeds the import's limit of {limit}",
+                    accessor.index()
+                )));
+            }
+            let zeros = Cow::Owned(vec![0u8; count * size]);
+            return self.substitute(accessor, what, zeros, size, count);
+        };
+        let data = self.view(&view, what)?;
+        let stride = view.stride().unwrap_or(size);
         // an empty accessor still has to start inside its view: its data is sliced from there
         let need = if count == 0 {
             Some(accessor.offset())
@@ -423,14 +443,66 @@ impl Importer<'_> {
                 data.len()
             )));
         }
-        if accessor.sparse().is_some() {
-            return Err(GltfError::Unsupported {
-                path: self.path.to_path_buf(),
-                extension: "sparse accessors".into(),
-                hint: "write them out dense first (e.g. `gltf-transform copy`)",
-            });
+        let data = &data[accessor.offset()..];
+        if sparse.is_none() {
+            return Ok((Cow::Borrowed(data), stride, count));
         }
-        Ok((&data[accessor.offset()..], stride, count))
+        // dense copy (bounded by the view's bytes just checked), then the substitutions
+        let mut dense = vec![0u8; count * size];
+        for (i, e) in dense.chunks_exact_mut(size.max(1)).enumerate() {
+            e.copy_from_slice(&data[i * stride..i * stride + size]);
+        }
+        self.substitute(accessor, what, Cow::Owned(dense), size, count)
+    }
+
+    /// Writes sparse `accessor`'s substituted elements into its dense `data`.
+    fn substitute<'b>(
+        &self,
+        accessor: &gltf::Accessor,
+        what: &str,
+        data: Cow<'b, [u8]>,
+        size: usize,
+        count: usize,
+    ) -> Result<(Cow<'b, [u8]>, usize, usize), GltfError> {
+        let Some(sparse) = accessor.sparse() else { return Ok((data, size, count)) };
+        let mut data = data.into_owned();
+        let n = sparse.count();
+        let (indices, values) = (sparse.indices(), sparse.values());
+        let index_size = match indices.index_type() {
+            gltf::accessor::sparse::IndexType::U8 => 1,
+            gltf::accessor::sparse::IndexType::U16 => 2,
+            gltf::accessor::sparse::IndexType::U32 => 4,
+        };
+        let part = |view: &gltf::buffer::View, offset: usize, bytes: Option<usize>, name: &str| {
+            let d = self.view(view, what)?;
+            match bytes.and_then(|b| b.checked_add(offset)) {
+                Some(end) if end <= d.len() => Ok(&d[offset..end]),
+                _ => Err(self.malformed(format!(
+                    "{what}: sparse accessor {}'s {n} {name} (offset {offset}) run past buffer view {} of {} bytes",
+                    accessor.index(),
+                    view.index(),
+                    d.len()
+                ))),
+            }
+        };
+        let index_bytes = part(&indices.view(), indices.offset(), n.checked_mul(index_size), "indices")?;
+        let value_bytes = part(&values.view(), values.offset(), n.checked_mul(size), "values")?;
+        for (k, v) in value_bytes.chunks_exact(size.max(1)).enumerate() {
+            let e = &index_bytes[k * index_size..];
+            let i = match index_size {
+                1 => usize::from(e[0]),
+                2 => usize::from(u16::from_le_bytes([e[0], e[1]])),
+                _ => u32::from_le_bytes([e[0], e[1], e[2], e[3]]) as usize,
+            };
+            if i >= count {
+                return Err(self.malformed(format!(
+                    "{what}: sparse accessor {} substitutes element {i} of {count}",
+                    accessor.index()
+                )));
+            }
+            data[i * size..(i + 1) * size].copy_from_slice(v);
+        }
+        Ok((Cow::Owned(data), size, count))
     }
 
     /// TEXCOORD values: floats, or unsigned bytes or shorts normalized to [0, 1].

@@ -46,16 +46,69 @@ fn the_sample_cameras_first_perspective_camera_is_used() {
     assert!((c.hfov_degrees - 0.7f32.to_degrees()).abs() < 1e-3, "{c:?}");
 }
 
+/// SimpleSparseAccessor.gltf: a 7 x 2 grid of vertices (x 0..6, y 0 and 1) whose POSITION
+/// accessor substitutes three of them sparsely: vertices 8, 10 and 12 (x 1, 3, 5 of the top
+/// row) rise to y 2, 3 and 4 (the sample's README).
 #[test]
-fn the_sparse_sample_is_refused_naming_what_to_do() {
-    let path = model("SimpleSparseAccessor.gltf");
-    let e = load_gltf(&path, &GltfOptions::default()).expect_err("sparse accessors are not read");
-    assert!(matches!(&e, GltfError::Unsupported { extension, .. } if extension == "sparse accessors"), "{e}");
+fn the_sparse_sample_reads_its_substituted_vertices() {
+    let import =
+        load_gltf(&model("SimpleSparseAccessor.gltf"), &GltfOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    let [object] = import.scene.objects.as_slice() else { panic!("{} objects", import.scene.objects.len()) };
+    assert_eq!(object.mesh.indices.len(), 12);
+    let key = |p: Vec3| p.to_array().map(f32::to_bits);
+    let mut want: Vec<[u32; 3]> = (0..14)
+        .map(|i| {
+            let (x, row) = ((i % 7) as f32, i / 7);
+            let y = match i {
+                8 => 2.0,
+                10 => 3.0,
+                12 => 4.0,
+                _ => row as f32,
+            };
+            key(Vec3::new(x, y, 0.0))
+        })
+        .collect();
+    let mut got: Vec<[u32; 3]> = object.mesh.positions.iter().map(|&p| key(p)).collect();
+    want.sort_unstable();
+    got.sort_unstable();
+    assert_eq!(got, want);
+}
+
+/// Sparse substitutions that point past the accessor, or whose indices or values run past
+/// their view, are refused in one line naming the file; a sparse accessor without a view
+/// starts from zeros.
+#[test]
+fn bad_sparse_accessors_are_refused_in_one_line() {
+    let text = std::fs::read_to_string(model("SimpleSparseAccessor.gltf")).expect("read");
+    let d = std::env::temp_dir().join(format!("envshadow-sparse-{}", std::process::id()));
+    std::fs::create_dir_all(&d).expect("temp dir");
+    let edit = |name: &str, change: &dyn Fn(&mut Value)| {
+        let mut doc: Value = serde_json::from_str(&text).expect("json");
+        change(&mut doc["accessors"][1]);
+        let path = d.join(name);
+        std::fs::write(&path, serde_json::to_vec(&doc).expect("json")).expect("write");
+        (path.clone(), load_gltf(&path, &GltfOptions::default()))
+    };
+    for (name, change, reason) in [
+        ("past.gltf", &(|a: &mut Value| a["count"] = 12.into()) as &dyn Fn(&mut Value), "substitutes element 12 of 12"),
+        ("many.gltf", &|a: &mut Value| a["sparse"]["count"] = 100.into(), "run past buffer view"),
+        ("offset.gltf", &|a: &mut Value| a["sparse"]["values"]["byteOffset"] = 8.into(), "values (offset 8) run past"),
+    ] {
+        let (path, result) = edit(name, change);
+        let e = result.err().unwrap_or_else(|| panic!("{name}: imported"));
+        let msg = e.to_string();
+        assert!(matches!(e, GltfError::Malformed { .. }), "{name}: {msg}");
+        assert!(msg.contains(path.to_str().expect("utf-8")) && msg.contains(reason) && !msg.contains('\n'), "{msg}");
+    }
+    // without its view the base is zeros: every triangle keeps two vertices at the origin (each
+    // has one of the substituted three at most), so all twelve are dropped as degenerate
+    let (_, zeros) = edit("zeros.gltf", &|a: &mut Value| {
+        a.as_object_mut().expect("accessor").remove("bufferView");
+    });
+    let Err(e) = zeros else { panic!("zeros.gltf imported: all its triangles are degenerate") };
     let msg = e.to_string();
-    assert!(
-        msg.contains("SimpleSparseAccessor.gltf") && msg.contains("gltf-transform") && !msg.contains('\n'),
-        "{msg}"
-    );
+    assert!(msg.contains("no triangles (after dropping 12 degenerate ones)"), "{msg}");
+    std::fs::remove_dir_all(&d).ok();
 }
 
 #[test]
