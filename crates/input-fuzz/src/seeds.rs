@@ -233,8 +233,29 @@ fn sparse() -> (serde_json::Value, Vec<u8>) {
     (doc, bin)
 }
 
+/// `column` with every primitive Draco-compressed (`draco-gltf`'s encoder, 14-bit positions),
+/// its document and buffer; `None` if the encoder refuses.
+fn draco() -> Option<(serde_json::Value, Vec<u8>)> {
+    use draco_gltf::{CompressionOptions, MeshIndex, OutputFormat, QuantizationBits};
+    let (doc, bin) = scene::Scene::builtin("column").ok()?.to_gltf(None);
+    let raw = scene::glb_bytes(&serde_json::to_vec(&doc).ok()?, &bin)?;
+    let mut import = draco_gltf::import_slice(&raw, None).ok()?;
+    let quantization = QuantizationBits { position: Some(14), normal: Some(10), ..QuantizationBits::default() };
+    let options = CompressionOptions { quantization, ..CompressionOptions::default() };
+    for m in 0..import.document().meshes().len() {
+        for p in 0..import.document().mesh(MeshIndex(m)).map_or(0, |x| x.primitive_count()) {
+            import.compress_primitive(MeshIndex(m), p, options).ok()?;
+        }
+    }
+    let glb = import.to_bytes(OutputFormat::GlbV2).ok()?;
+    // the container's JSON and BIN chunks
+    let json_len = u32::from_le_bytes(glb.get(12..16)?.try_into().ok()?) as usize;
+    let doc = serde_json::from_slice(glb.get(20..20 + json_len)?).ok()?;
+    Some((doc, glb.get(20 + json_len + 8..)?.to_vec()))
+}
+
 /// The glTF seeds' documents and buffers: `three_boxes` and `column` as the export writes them,
-/// [`handmade`] and [`sparse`].
+/// [`handmade`], [`sparse`] and [`draco`].
 fn models() -> Vec<(serde_json::Value, Vec<u8>)> {
     let mut out: Vec<_> = ["three_boxes", "column"]
         .iter()
@@ -243,6 +264,7 @@ fn models() -> Vec<(serde_json::Value, Vec<u8>)> {
         .collect();
     out.push(handmade());
     out.push(sparse());
+    out.extend(draco());
     out
 }
 

@@ -261,18 +261,19 @@ fn bad_files_are_errors_naming_the_file() {
     // points only: nothing to draw
     let points = write_gltf(&d, "points", &document(&p, &idx, 0, Some("points.bin"), r#"[{"mesh": 0}]"#, ""), &b);
     assert!(matches!(refused(&points), GltfError::NoTriangles { .. }));
-    // compressed geometry
-    let draco = write_gltf(
-        &d,
-        "draco",
-        &doc(r#",
-  "extensionsUsed": ["KHR_draco_mesh_compression"], "extensionsRequired": ["KHR_draco_mesh_compression"]"#)
-        .replace("x.bin", "draco.bin"),
-        &b,
-    );
+    // compressed geometry: meshopt is refused; Draco is decoded (`tests/draco.rs`), and a file
+    // that requires it without a Draco primitive reads as it is
+    let requiring = |name: &str, ext: &str| {
+        let extra = format!(r#", "extensionsUsed": ["{ext}"], "extensionsRequired": ["{ext}"]"#);
+        write_gltf(&d, name, &doc(&extra).replace("x.bin", &format!("{name}.bin")), &b)
+    };
+    let meshopt = requiring("meshopt", "EXT_meshopt_compression");
     assert!(
-        matches!(refused(&draco), GltfError::Unsupported { extension, .. } if extension == "KHR_draco_mesh_compression")
+        matches!(refused(&meshopt), GltfError::Unsupported { extension, .. } if extension == "EXT_meshopt_compression")
     );
+    let draco = requiring("draco", "KHR_draco_mesh_compression");
+    let plain = load_gltf(&draco, &GltfOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    assert!(plain.warnings.is_empty() && !plain.scene.objects.is_empty(), "{:?}", plain.warnings);
     // what the gltf crate itself panics on (found by `cargo xtask fuzz`): a GLB header whose
     // length is under its own 12 bytes, a POSITION past the accessors
     let mut short = full.clone();
