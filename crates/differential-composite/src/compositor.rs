@@ -67,7 +67,34 @@ pub struct Compositor {
     vertex_colour: Vec<Vec3>,
     /// Per source, its set in the two-set split (paper: the parity of a random id).
     pub set_of: Vec<u8>,
+    /// Per pixel, what its darkening is multiplied by: the pixel's own reflectance over its
+    /// receiver's, where the photograph's texture varies within a patch (a backdrop's ground;
+    /// [`Compositor::with_pixel_reflectance`]); 1 elsewhere.
+    pub pixel_scale: Vec<Vec3>,
+    /// How the object's irradiance probe sees the map ([`ObjectProbe`]).
+    pub probe: ObjectProbe,
+    /// Lights the object is shaded by per pixel (a sun: SH9 rings around it), each where its
+    /// direction escapes the model from the object's centre; the probe leaves them out.
+    pub object_lights: Vec<DistantLight>,
+    /// Whether a blocked source's darkening is reduced by the object's own radiance seen in
+    /// its place (the object hides the sky but reflects light itself): the transfer times
+    /// 1 - L_object / L_sources per channel, L_object the object's radiance facing away from
+    /// the representative's direction. `false`: the paper's, the source's light removed whole.
+    pub object_replaces_sources: bool,
     bvh: Box<dyn Visibility>,
+}
+
+/// How [`Compositor::irradiance_at`] takes the map: the object's lighting.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ObjectProbe {
+    /// Probe rays see the model and the map, except inside the cones of the first this many
+    /// lights, which are added as their cones' power along their axes (a sun of a few texels
+    /// is found by no probe ray).
+    Lights(usize),
+    /// The map's own SH9 projection, every texel exact (its sun included), with what probe rays
+    /// find of the model in place of the map where they meet it: for a model that hides only a
+    /// little of the sky (a backdrop's ground), whose lights tile the map.
+    Map(Sh9),
 }
 
 /// One representative's share of a frame.
@@ -87,6 +114,13 @@ pub struct RepTransfer {
     pub transfer: f64,
     /// Sources it stands for.
     pub sources: u32,
+    /// For a distant origin, the angular radius (radians) of the cone around its direction
+    /// that holds every occluded source it stands for, their own cones included: its shadow's
+    /// penumbra (0 for a point origin).
+    pub half_angle: f32,
+    /// The mean radiance over the solid angle of the distant sources it stands for (zero for
+    /// patches).
+    pub source_radiance: Vec3,
 }
 
 /// A frame's transfers.
@@ -106,6 +140,18 @@ pub struct FrameTransfers {
     pub shading: Duration,
     /// The object's SH9 irradiance at its centre (its shading).
     pub object_irradiance: Sh9,
+    /// The lights it is shaded by per pixel besides ([`Compositor::object_lights`] that reach
+    /// its centre).
+    pub object_lights: Vec<DistantLight>,
+}
+
+impl FrameTransfers {
+    /// The object's irradiance for unit normal `n`: the probe's SH9 plus its lights.
+    #[must_use]
+    pub fn object_irradiance_at(&self, n: Vec3) -> Vec3 {
+        let lights: Vec3 = self.object_lights.iter().map(|l| l.power() * n.dot(l.direction).max(0.0)).sum();
+        self.object_irradiance.irradiance(n) + lights
+    }
 }
 
 impl FrameTransfers {
@@ -166,6 +212,8 @@ impl Compositor {
         let mut rng = rand_pcg::Pcg32::seed_from_u64(3);
         let set_of = prepared.sources.iter().map(|_| (rng.random::<u32>() & 1) as u8).collect();
         let pixels = pixel_refs(&model, &prepared, bvh.as_ref());
+        let pixel_scale = vec![Vec3::ONE; pixels.len()];
+        let probe = ObjectProbe::Lights(lights.len());
         Ok(Self {
             model,
             lights,
@@ -181,8 +229,41 @@ impl Compositor {
             source_colour,
             vertex_colour,
             set_of,
+            pixel_scale,
+            probe,
+            object_lights: Vec::new(),
+            object_replaces_sources: false,
             bvh,
         })
+    }
+
+    /// Scales each receiver pixel's darkening by `reflectance` there (the photograph's own
+    /// estimate, per pixel, row-major) over its receiver's reflectance: transfers are per
+    /// patch, a textured ground is not, and a shadow darkens each texel in proportion to it.
+    /// Channels where the receiver reflects nothing keep 1.
+    ///
+    /// # Errors
+    /// [`CompositeError::Parameter`] when `reflectance` is not one value per pixel.
+    pub fn with_pixel_reflectance(mut self, reflectance: &[Vec3]) -> Result<Self, CompositeError> {
+        if reflectance.len() != self.pixels.len() {
+            return Err(CompositeError::Parameter(format!(
+                "{} reflectances for {} pixels",
+                reflectance.len(),
+                self.pixels.len()
+            )));
+        }
+        for ((scale, px), rho) in self.pixel_scale.iter_mut().zip(&self.pixels).zip(reflectance) {
+            if px.slot == u32::MAX {
+                continue;
+            }
+            let patch = self.prepared.receivers[px.slot as usize / 4] as usize;
+            let mine = self.model.patches[patch].reflectance;
+            *scale = Vec3::from_array(std::array::from_fn(|c| {
+                let (r, m) = (rho[c], mine[c]);
+                if m > 0.0 && r.is_finite() { (r / m).clamp(0.0, 1e3) } else { 1.0 }
+            }));
+        }
+        Ok(self)
     }
 
     /// The model's visibility queries.
@@ -222,6 +303,9 @@ impl Compositor {
             .iter()
             .map(|rep| {
                 let mut radiance = vec![Vec3::ZERO; slots];
+                let origin = self.prepared.origin(&self.model, &self.lights, rep.origin);
+                let mut half_angle = 0.0f32;
+                let (mut power, mut solid_angle) = (Vec3::ZERO, 0.0f32);
                 for &j in self.hierarchy.source_tree.items(rep.node) {
                     if !occluded[j as usize] {
                         continue;
@@ -229,32 +313,64 @@ impl Compositor {
                     for &s in &receiver_slots {
                         radiance[s] += self.transfer_rgb(j as usize, s);
                     }
+                    if let (Origin::Direction(d), Source::Distant(k)) = (origin, self.prepared.sources[j as usize]) {
+                        let l = &self.lights[k as usize];
+                        let apart = d.dot(l.direction).clamp(-1.0, 1.0).acos();
+                        half_angle = half_angle.max(apart + l.half_angle());
+                        power += l.power();
+                        solid_angle += l.solid_angle;
+                    }
                 }
                 RepTransfer {
-                    origin: self.prepared.origin(&self.model, &self.lights, rep.origin),
+                    origin,
                     origin_source: rep.origin,
                     radiance,
                     intensity: Vec::new(),
                     transfer: rep.transfer,
                     sources: rep.sources,
+                    half_angle: half_angle.min(std::f32::consts::FRAC_PI_2 * 0.9),
+                    source_radiance: if solid_angle > 0.0 { power / solid_angle } else { Vec3::ZERO },
                 }
             })
             .collect();
         out.sort_by(|a, b| b.transfer.total_cmp(&a.transfer));
         // each representative's set: its origin source's (the sources are split by random ids)
         let sets: Vec<u8> = out.iter().map(|r| self.set_of[r.origin_source as usize]).collect();
-        self.intensity_transfers(&mut out, &receiver_slots, &sets);
         let transfers = t.elapsed();
         let t = Instant::now();
         let object_irradiance = self.irradiance_at(object.centre);
+        let object_lights: Vec<DistantLight> =
+            self.object_lights.iter().filter(|l| self.bvh.escapes(object.centre, l.direction)).copied().collect();
+        let shading = t.elapsed();
+        let t = Instant::now();
+        if self.object_replaces_sources {
+            // the object's side that stands in a source's place faces receivers, which it
+            // shadows: its light from the sky alone (the ground under it is in its shadow)
+            let sky = self.sky_irradiance_at(object.centre);
+            let lit =
+                FrameTransfers { object_irradiance: sky, object_lights: object_lights.clone(), ..Default::default() };
+            for rep in &mut out {
+                let Origin::Direction(d) = rep.origin else { continue };
+                // the object's radiance facing the receivers below the sources, in their place
+                let sources = rep.source_radiance;
+                let own = object.albedo / std::f32::consts::PI * lit.object_irradiance_at(-d).max(Vec3::ZERO);
+                let keep = Vec3::from_array(std::array::from_fn(|c| {
+                    if sources[c] > 0.0 { (1.0 - own[c] / sources[c]).clamp(0.0, 1.0) } else { 1.0 }
+                }));
+                rep.radiance.iter_mut().for_each(|v| *v *= keep);
+            }
+        }
+        self.intensity_transfers(&mut out, &receiver_slots, &sets);
+        let transfers = transfers + t.elapsed();
         FrameTransfers {
             reps: out,
             occluded_sources: occlusion.sources.len(),
             occluded_receivers: occlusion.receivers.len(),
             traversal,
             transfers,
-            shading: t.elapsed(),
+            shading,
             object_irradiance,
+            object_lights,
         }
     }
 
@@ -276,19 +392,38 @@ impl Compositor {
     }
 
     /// SH9 of the radiance arriving at `p` from the model (and the map past it): the object's
-    /// lighting, as paper 003's irradiance volume gives it. Where the scene has a map, each
-    /// extracted light that `p` sees is added as its cone's power along its axis (a sun of a
-    /// few texels is found by no probe ray) and its cone is left out of the probe.
+    /// lighting, as paper 003's irradiance volume gives it, the map taken as [`ObjectProbe`]
+    /// says.
     #[must_use]
     pub fn irradiance_at(&self, p: Vec3) -> Sh9 {
+        self.probe_at(p, true)
+    }
+
+    /// [`Compositor::irradiance_at`] with what the model reflects left out (the directions
+    /// where probe rays meet it are black): the light from the sky alone.
+    #[must_use]
+    pub fn sky_irradiance_at(&self, p: Vec3) -> Sh9 {
+        self.probe_at(p, false)
+    }
+
+    fn probe_at(&self, p: Vec3, with_model: bool) -> Sh9 {
+        let model = |patch: u32| if with_model { self.model.patches[patch as usize].radiance } else { Vec3::ZERO };
         // 2 x 2 rays a texel: a small bright source (the lamp, a third of a texel at 32 x 16)
         // must not hinge on whether a texel centre finds it
         let (w, h) = (64u32, 32u32);
-        let in_a_light = |d: Vec3| self.lights.iter().any(|l| d.dot(l.direction) >= l.cos_half_angle());
-        let radiance = |d: Vec3| match self.bvh.first_hit(p, d) {
-            Some((patch, _)) => self.model.patches[patch as usize].radiance,
-            None if in_a_light(d) => Vec3::ZERO,
-            None => self.map.as_ref().map_or(Vec3::ZERO, |m| m.lookup(d)),
+        let lights = match &self.probe {
+            ObjectProbe::Lights(n) => &self.lights[..(*n).min(self.lights.len())],
+            ObjectProbe::Map(_) => &[],
+        };
+        let in_a_light = |d: Vec3| lights.iter().any(|l| d.dot(l.direction) >= l.cos_half_angle());
+        let map = |d: Vec3| self.map.as_ref().map_or(Vec3::ZERO, |m| m.lookup(d));
+        let radiance = |d: Vec3| match (self.bvh.first_hit(p, d), &self.probe) {
+            // the model in place of the map, which the exact projection already holds
+            (Some((patch, _)), ObjectProbe::Map(_)) => model(patch) - map(d),
+            (Some((patch, _)), _) => model(patch),
+            (None, ObjectProbe::Map(_)) => Vec3::ZERO,
+            (None, _) if in_a_light(d) => Vec3::ZERO,
+            (None, _) => map(d),
         };
         let probe = EnvMap::from_texels(w, h, |i, j| {
             [(0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)]
@@ -300,8 +435,11 @@ impl Compositor {
                 .sum::<Vec3>()
                 / 4.0
         });
-        let mut sh = Sh9::project(&probe);
-        for l in self.lights.iter().filter(|l| self.bvh.escapes(p, l.direction)) {
+        let mut sh = match &self.probe {
+            ObjectProbe::Map(map_sh) => signed_projection(&probe, map_sh),
+            ObjectProbe::Lights(_) => Sh9::project(&probe),
+        };
+        for l in lights.iter().filter(|l| self.bvh.escapes(p, l.direction)) {
             let power = l.radiance * l.solid_angle;
             for (c, y) in sh.coeffs.iter_mut().zip(envmap_sphere::sh::sh9_basis(l.direction)) {
                 *c += power * y;
@@ -309,6 +447,16 @@ impl Compositor {
         }
         sh
     }
+}
+
+/// `base` plus the SH9 projection of `signed` (a map of signed radiance differences, which
+/// [`Sh9::project`] takes as they are).
+fn signed_projection(signed: &EnvMap, base: &Sh9) -> Sh9 {
+    let mut sh = Sh9::project(signed);
+    for (c, b) in sh.coeffs.iter_mut().zip(base.coeffs) {
+        *c += b;
+    }
+    sh
 }
 
 /// Each pixel's receiver: the centre ray's first patch, its slot and bilinear weights.

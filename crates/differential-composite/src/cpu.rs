@@ -86,8 +86,7 @@ pub fn composite(
     let (w, h) = c.size;
     let rays = c.model.camera.rays();
     let eps = c.model_bvh().epsilon();
-    let shade =
-        |n: Vec3| (object.albedo / std::f32::consts::PI * frame.object_irradiance.irradiance(n)).max(Vec3::ZERO);
+    let shade = |n: Vec3| (object.albedo / std::f32::consts::PI * frame.object_irradiance_at(n)).max(Vec3::ZERO);
     (0..h)
         .into_par_iter()
         .flat_map_iter(|y| {
@@ -124,6 +123,7 @@ pub fn composite(
                         };
                         sum += (0..4).map(|v| px.weights[v] * per_vertex[slot + v]).sum::<Vec3>();
                     }
+                    sum *= c.pixel_scale[k];
                 }
                 if sum == Vec3::ZERO && covered == 0 {
                     return c.photo_ldr[k];

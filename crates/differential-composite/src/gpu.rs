@@ -16,7 +16,7 @@ use std::time::{Duration, Instant};
 
 use glam::Vec3;
 use gpu::{GBuffer, GBufferPass, Gpu, GpuError, SceneGeometry, ShadowGeometry};
-use shadowmap_paraboloid::{DEPTH_FORMAT, MapView, ShadowMapper, ShadowSettings, Technique};
+use shadowmap_paraboloid::{DEPTH_FORMAT, MapView, Pcss, ShadowMapper, ShadowSettings, Technique};
 use shaft_hierarchy::preprocess::{Origin, Source};
 
 use crate::compositor::{Compositor, FrameTransfers, RepTransfer};
@@ -35,12 +35,28 @@ pub struct GpuSettings {
     /// Most layers of one texture array of maps (a frame's maps share as few arrays as this
     /// allows, one mask dispatch each); `None`: the adapter's limit.
     pub layers_per_array: Option<u32>,
+    /// Soft shadows of distant representatives: percentage-closer soft shadows over the cone
+    /// holding the sources each stands for ([`RepTransfer::half_angle`]); `None`: the paper's
+    /// hard masks.
+    pub pcss: Option<Pcss>,
+    /// n x n G-buffer samples a pixel for the object's coverage (its edge antialiased: the
+    /// object's mean radiance blended over the darkened photograph); 1: the pixel centre alone
+    /// (the paper's), at most 4.
+    pub coverage_samples: u32,
 }
 
 impl Default for GpuSettings {
-    /// The paper's: 256^2 maps, a 484-triangle sphere, hemispherical paraboloid maps.
+    /// The paper's: 256^2 maps, a 484-triangle sphere, hemispherical paraboloid maps, hard
+    /// masks.
     fn default() -> Self {
-        Self { map_resolution: 256, shadow_detail: 22, patch_maps: Technique::DualParaboloid, layers_per_array: None }
+        Self {
+            map_resolution: 256,
+            shadow_detail: 22,
+            patch_maps: Technique::DualParaboloid,
+            layers_per_array: None,
+            pcss: None,
+            coverage_samples: 1,
+        }
     }
 }
 
@@ -114,6 +130,8 @@ impl FrameTimes {
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct GpuPixel {
     weights: [f32; 4],
+    position: [f32; 4],
+    normal: [f32; 4],
     slot: u32,
     pad: [u32; 3],
 }
@@ -136,18 +154,27 @@ struct ResolveParams {
     height: u32,
     mode: u32,
     object: u32,
+    samples: u32,
+    light_count: u32,
+    pad: [u32; 2],
     response: [f32; 4],
     albedo: [f32; 4],
     irradiance: [[f32; 4]; 9],
+    lights: [[f32; 4]; 16],
 }
+
+/// Lights the resolve shades the object by per pixel.
+pub const MAX_OBJECT_LIGHTS: usize = 8;
 
 /// The GPU compositor of one [`Compositor`]: its static buffers and pipelines.
 pub struct GpuCompositor {
     pixels: wgpu::Buffer,
     photo_hdr: wgpu::Buffer,
     photo_ldr: wgpu::Buffer,
+    pixel_scale: wgpu::Buffer,
     darkening: wgpu::Buffer,
     out: wgpu::Buffer,
+    out_hdr: wgpu::Buffer,
     masks: wgpu::ComputePipeline,
     resolve: wgpu::ComputePipeline,
     gbuffer: GBufferPass,
@@ -170,10 +197,24 @@ impl GpuCompositor {
                 usage: wgpu::BufferUsages::STORAGE | extra,
             })
         };
-        let table: Vec<GpuPixel> =
-            c.pixels.iter().map(|p| GpuPixel { weights: p.weights, slot: p.slot, pad: [0; 3] }).collect();
+        let table: Vec<GpuPixel> = c
+            .pixels
+            .iter()
+            .map(|p| {
+                // a pixel that meets nothing keeps no point (slot NONE: the masks skip it)
+                let finite = |v: Vec3| if v.is_finite() { v.extend(0.0).to_array() } else { [0.0; 4] };
+                GpuPixel {
+                    weights: p.weights,
+                    position: finite(p.position),
+                    normal: finite(p.normal),
+                    slot: p.slot,
+                    pad: [0; 3],
+                }
+            })
+            .collect();
         let hdr: Vec<[f32; 4]> = c.photo_hdr.iter().map(|v| v.extend(1.0).to_array()).collect();
         let ldr: Vec<u32> = c.photo_ldr.iter().map(|p| pack(*p)).collect();
+        let scale: Vec<[f32; 4]> = c.pixel_scale.iter().map(|v| v.extend(1.0).to_array()).collect();
         let n = u64::from(w) * u64::from(h);
         let module =
             |label: &str, src: &str| gpu::shader::module(&gpu.device, label, src, shadowmap_paraboloid::LIBRARY);
@@ -194,6 +235,7 @@ impl GpuCompositor {
             pixels: storage("composite pixels", bytemuck::cast_slice(&table), wgpu::BufferUsages::empty()),
             photo_hdr: storage("photo hdr", bytemuck::cast_slice(&hdr), wgpu::BufferUsages::empty()),
             photo_ldr: storage("photo ldr", bytemuck::cast_slice(&ldr), wgpu::BufferUsages::empty()),
+            pixel_scale: storage("pixel scale", bytemuck::cast_slice(&scale), wgpu::BufferUsages::empty()),
             darkening: gpu.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("darkening"),
                 size: n * 16,
@@ -203,6 +245,12 @@ impl GpuCompositor {
             out: gpu.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("composite"),
                 size: n * 4,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            }),
+            out_hdr: gpu.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("composite hdr"),
+                size: n * 16,
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             }),
@@ -240,7 +288,7 @@ impl GpuCompositor {
         };
         let mut gb = None;
         times.gbuffer = stage("composite g-buffer", &mut |e| {
-            gb = Some(self.record_gbuffer(gpu, e, c, object)?);
+            gb = Some(self.record_gbuffer(gpu, e, c, object, settings)?);
             Ok(())
         })?;
         let gb = gb.ok_or_else(|| GpuError::Failed("composite: no G-buffer".into()))?;
@@ -251,7 +299,7 @@ impl GpuCompositor {
         })?;
         let maps = maps.ok_or_else(|| GpuError::Failed("composite: no maps".into()))?;
         times.masks = stage("composite masks", &mut |e| {
-            self.record_masks(gpu, e, c, frame, mode, &gb, &maps);
+            self.record_masks(gpu, e, c, frame, mode, &maps);
             Ok(())
         })?;
         let t = Instant::now();
@@ -282,9 +330,9 @@ impl GpuCompositor {
         mode: Mode,
         settings: &GpuSettings,
     ) -> Result<MapWork, GpuError> {
-        let gb = self.record_gbuffer(gpu, encoder, c, object)?;
+        let gb = self.record_gbuffer(gpu, encoder, c, object, settings)?;
         let maps = self.record_maps(gpu, encoder, c, frame, object, settings)?;
-        self.record_masks(gpu, encoder, c, frame, mode, &gb, &maps);
+        self.record_masks(gpu, encoder, c, frame, mode, &maps);
         self.record_resolve(gpu, encoder, c, &gb, frame, object, mode);
         Ok(maps.work)
     }
@@ -305,6 +353,25 @@ impl GpuCompositor {
         Ok(bytes.chunks_exact(4).map(|p| [p[0], p[1], p[2]]).collect())
     }
 
+    /// The composite in radiance once its encoder has run (HDR mode: what the 8-bit output is
+    /// the camera response of; LDR mode leaves the photograph's radiance where it subtracts
+    /// codes): a `vec4<f32>` per pixel, row-major (`STORAGE | COPY_SRC`).
+    #[must_use]
+    pub fn output_hdr(&self) -> &wgpu::Buffer {
+        &self.out_hdr
+    }
+
+    /// Reads [`GpuCompositor::output_hdr`] back (its work submitted): a wait.
+    ///
+    /// # Errors
+    /// GPU failures.
+    pub fn read_output_hdr(&self, gpu: &Gpu) -> Result<Vec<Vec3>, GpuError> {
+        let bytes = gpu::read_buffer(gpu, &self.out_hdr)?;
+        // the bytes need not be aligned for f32
+        let f = |b: &[u8]| f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+        Ok(bytes.chunks_exact(16).map(|p| Vec3::new(f(&p[0..4]), f(&p[4..8]), f(&p[8..12]))).collect())
+    }
+
     /// The G-buffer of the reconstruction with the object (its index: after the patches).
     fn record_gbuffer(
         &self,
@@ -312,11 +379,16 @@ impl GpuCompositor {
         encoder: &mut wgpu::CommandEncoder,
         c: &Compositor,
         object: &SyntheticObject,
+        settings: &GpuSettings,
     ) -> Result<GBuffer, GpuError> {
         let mut scene = c.model.to_scene();
         scene.objects.push(object.to_object());
         let geometry = SceneGeometry::upload(gpu, &scene)?;
-        self.gbuffer.record(gpu, encoder, &geometry, &scene.camera)
+        // n x n samples a pixel for the object's coverage: the same camera at n times the size
+        let n = settings.coverage_samples.clamp(1, 4);
+        let camera = scene::Camera { width: scene.camera.width * n, height: scene.camera.height * n, ..scene.camera };
+        gpu.check_texture(camera.width, camera.height, 1)?;
+        self.gbuffer.record(gpu, encoder, &geometry, &camera)
     }
 
     /// Every representative's map, into layers of as few texture arrays as the adapter allows.
@@ -336,6 +408,7 @@ impl GpuCompositor {
         let casters = ShadowGeometry::upload(gpu, &casters, ShadowGeometry::CHUNK_TRIANGLES)?;
         let map_settings = ShadowSettings {
             resolution: settings.map_resolution,
+            pcss: settings.pcss,
             // the object's few hundred triangles subtend a small angle from a source
             subdivide_angle: None,
             ..ShadowSettings::default()
@@ -353,7 +426,7 @@ impl GpuCompositor {
             let array = gpu::render_target(gpu, "composite shadow maps", (res, res, layers), DEPTH_FORMAT)?;
             let mut layer = 0;
             let mut mine = Vec::with_capacity(end - first);
-            for (light, technique) in &lights[first..end] {
+            for ((light, technique), rep) in lights[first..end].iter().zip(&frame.reps[first..end]) {
                 let map = self.mapper.record(
                     gpu,
                     encoder,
@@ -364,7 +437,7 @@ impl GpuCompositor {
                     Some((&array, layer)),
                     shadowmap_paraboloid::OnGpu::default(),
                 )?;
-                mine.push(map.lookup_params(0.0, layer));
+                mine.push(map.lookup_params(rep.half_angle, layer));
                 layer += map.views.len() as u32;
                 work.views += map.views.len() as u32;
                 // a hemispherical light's paraboloid map has its front view alone
@@ -389,7 +462,6 @@ impl GpuCompositor {
         c: &Compositor,
         frame: &FrameTransfers,
         mode: Mode,
-        gb: &GBuffer,
         maps: &Maps,
     ) {
         let (w, h) = self.size;
@@ -411,8 +483,6 @@ impl GpuCompositor {
         };
         let transfer_buffer = buffer("transfers", bytemuck::cast_slice(&transfers), wgpu::BufferUsages::STORAGE);
         encoder.clear_buffer(&self.darkening, 0, None);
-        let position = gb.position.create_view(&wgpu::TextureViewDescriptor::default());
-        let normal = gb.geometric_normal.create_view(&wgpu::TextureViewDescriptor::default());
         for ((array, mine), &(first, _)) in maps.arrays.iter().zip(&maps.params).zip(&maps.batches) {
             let uniform = MaskParams {
                 width: w,
@@ -438,9 +508,7 @@ impl GpuCompositor {
                     wgpu::BindGroupEntry { binding: 2, resource: transfer_buffer.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 3, resource: params.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&depth) },
-                    wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&position) },
-                    wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::TextureView(&normal) },
-                    wgpu::BindGroupEntry { binding: 7, resource: self.darkening.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 5, resource: self.darkening.as_entire_binding() },
                 ],
             });
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor::default());
@@ -465,14 +533,24 @@ impl GpuCompositor {
     ) {
         let (w, h) = self.size;
         let irradiance = frame.object_irradiance.irradiance_coefficients().map(|v| v.extend(0.0).to_array());
+        let lights: Vec<[f32; 4]> = frame
+            .object_lights
+            .iter()
+            .take(MAX_OBJECT_LIGHTS)
+            .flat_map(|l| [l.direction.extend(0.0).to_array(), l.power().extend(0.0).to_array()])
+            .collect();
         let params = ResolveParams {
             width: w,
             height: h,
             mode: u32::from(mode == Mode::Ldr),
             object: c.model.patches.len() as u32,
+            samples: gb.position.width() / w.max(1),
+            light_count: lights.len() as u32 / 2,
+            pad: [0; 2],
             response: [c.response.exposure, 1.0 / c.response.gamma, c.response.white, 0.0],
             albedo: (object.albedo / std::f32::consts::PI).extend(0.0).to_array(),
             irradiance,
+            lights: std::array::from_fn(|k| lights.get(k).copied().unwrap_or([0.0; 4])),
         };
         let uniform = gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("resolve params"),
@@ -492,6 +570,8 @@ impl GpuCompositor {
                 wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&position) },
                 wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&normal) },
                 wgpu::BindGroupEntry { binding: 6, resource: self.out.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 7, resource: self.pixel_scale.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 8, resource: self.out_hdr.as_entire_binding() },
             ],
         });
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor::default());

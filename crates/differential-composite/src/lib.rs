@@ -27,9 +27,9 @@ pub mod ldr;
 pub mod metrics;
 pub mod object;
 
-pub use compositor::{Compositor, FrameTransfers, PixelRef, RepTransfer};
+pub use compositor::{Compositor, FrameTransfers, ObjectProbe, PixelRef, RepTransfer};
 pub use metrics::{CodeError, code_error};
-pub use object::{BUILTIN_OBJECTS, MODEL_SIZE, Shape, SyntheticObject};
+pub use object::{BUILTIN_OBJECTS, MODEL_SIZE, ObjectPlacement, Shape, SyntheticObject};
 
 /// Which framebuffer the compositor subtracts in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -36,6 +36,40 @@ pub enum Shape {
     Model,
 }
 
+/// Where and how large [`SyntheticObject::open_placed`] puts an object.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ObjectPlacement {
+    /// Where its bounding box's bottom centre goes (y = 0: standing on the ground).
+    pub at: Vec3,
+    /// Its size times this.
+    pub scale: f32,
+    /// A turn about the vertical, degrees (counter-clockwise seen from above).
+    pub rotate_y_degrees: f32,
+    /// Fit a model's largest side to this many metres first (`None`: the model's own size;
+    /// built-ins keep theirs either way).
+    pub size: Option<f32>,
+}
+
+impl ObjectPlacement {
+    /// Standing at `at`, as it is.
+    #[must_use]
+    pub fn at(at: Vec3) -> Self {
+        Self { at, scale: 1.0, rotate_y_degrees: 0.0, size: None }
+    }
+
+    fn check(&self) -> Result<(), CompositeError> {
+        let size_ok = self.size.is_none_or(|s| s.is_finite() && s > 0.0);
+        let finite = self.at.is_finite() && self.scale.is_finite() && self.rotate_y_degrees.is_finite();
+        if !(finite && self.scale > 0.0 && size_ok) {
+            return Err(CompositeError::Parameter(format!(
+                "placement at {}, scale {}, rotation {} degrees, size {:?}: positions finite, scale and size positive",
+                self.at, self.scale, self.rotate_y_degrees, self.size
+            )));
+        }
+        Ok(())
+    }
+}
+
 /// Radius of the built-in sphere and half the side of the built-in box, metres.
 pub const SIZE: f32 = 0.3;
 
@@ -154,6 +188,72 @@ impl SyntheticObject {
         ))
     }
 
+    /// A built-in object's name or a glTF model's path, placed as `placement` says: a model
+    /// at its own size (glTF's metres) or fitted into `placement.size`, times
+    /// `placement.scale`, turned about the vertical, its bounding box's bottom centre at
+    /// `placement.at` (on the ground when its y is 0). What the compositor does not model comes
+    /// back as warnings, with the import's own.
+    ///
+    /// # Errors
+    /// As [`SyntheticObject::open`]; a placement that is not finite, or a scale or size that
+    /// is not positive.
+    pub fn open_placed(spec: &str, placement: &ObjectPlacement) -> Result<(Self, Vec<String>), CompositeError> {
+        placement.check()?;
+        let (object, warnings) = if scene::is_model(spec) {
+            let (model, mut all) = scene::Scene::open(spec, &scene::import::GltfOptions::default())?;
+            let name =
+                std::path::Path::new(spec).file_stem().map_or_else(|| spec.to_string(), |s| s.to_string_lossy().into());
+            let (lo, hi) = model
+                .objects
+                .iter()
+                .flat_map(|o| &o.mesh.positions)
+                .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+            let extent = (hi - lo).max_element();
+            let extent = if extent.is_finite() && extent > 0.0 { extent } else { 1.0 };
+            let (object, mut warnings) = Self::from_scene(&name, &model, Vec3::new(0.0, 0.5 * extent, 0.0), extent)?;
+            all.append(&mut warnings);
+            (object, all)
+        } else {
+            (Self::builtin(spec, Vec3::new(0.0, SIZE, 0.0))?, Vec::new())
+        };
+        let (lo, hi) = object.extent();
+        let fit = placement.size.map_or(1.0, |size| size / (hi - lo).max_element().max(f32::MIN_POSITIVE));
+        Ok((object.transformed(fit * placement.scale, placement.rotate_y_degrees, placement.at)?, warnings))
+    }
+
+    /// The object scaled by `scale` and turned by `rotate_y_degrees` about the vertical through
+    /// its bounding box's bottom centre, which then goes to `bottom`.
+    ///
+    /// # Errors
+    /// [`CompositeError::Parameter`] for a scale that is not finite and positive, or an angle
+    /// or position that is not finite.
+    pub fn transformed(&self, scale: f32, rotate_y_degrees: f32, bottom: Vec3) -> Result<Self, CompositeError> {
+        if !(scale.is_finite() && scale > 0.0 && rotate_y_degrees.is_finite() && bottom.is_finite()) {
+            return Err(CompositeError::Parameter(format!(
+                "object scale {scale}, rotation {rotate_y_degrees} degrees, position {bottom}: not finite and positive"
+            )));
+        }
+        let (lo, hi) = self.extent();
+        let anchor = Vec3::new(0.5 * (lo.x + hi.x), lo.y, 0.5 * (lo.z + hi.z));
+        let t = glam::Affine3A::from_translation(bottom)
+            * glam::Affine3A::from_rotation_y(rotate_y_degrees.to_radians())
+            * glam::Affine3A::from_scale(Vec3::splat(scale))
+            * glam::Affine3A::from_translation(-anchor);
+        let mut out = self.clone();
+        out.mesh.transform(&t);
+        out.centre = t.transform_point3(self.centre);
+        if !out.mesh.positions.iter().all(|p| p.is_finite()) {
+            return Err(CompositeError::Parameter(format!("object scale {scale}: its positions overflow")));
+        }
+        Ok(out)
+    }
+
+    /// The mesh's bounding box (min, max).
+    #[must_use]
+    pub fn extent(&self) -> (Vec3, Vec3) {
+        self.mesh.positions.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)))
+    }
+
     /// The same object moved by `offset` (mesh and centre).
     #[must_use]
     pub fn moved(&self, offset: Vec3) -> Self {
@@ -169,7 +269,9 @@ impl SyntheticObject {
     pub fn shadow_mesh(&self, detail: u32) -> Mesh {
         if self.shape == Shape::Sphere {
             let slices = detail.max(3);
-            uv_sphere(self.centre, SIZE, slices, (slices / 2).max(2))
+            // its radius as placed (the built-in's, times any scale)
+            let (lo, hi) = self.extent();
+            uv_sphere(self.centre, 0.5 * (hi.x - lo.x), slices, (slices / 2).max(2))
         } else {
             self.mesh.clone()
         }

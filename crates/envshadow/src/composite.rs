@@ -1,12 +1,13 @@
-//! `envshadow composite`: a synthetic object composited into a built-in real scene's
-//! photograph on the GPU (paper 003), against the path-traced truth and Debevec's offline
-//! differential rendering: errors in 8-bit codes, time per frame, the images; `--sweep` for
-//! every passes x HDR/LDR setting and Figure 3, `--path` for a moving object.
+//! `envshadow composite`: a synthetic object composited on the GPU (paper 003) into a built-in
+//! real scene's photograph (`--scene`), against the path-traced truth and Debevec's offline
+//! differential rendering, or onto a user's HDRI (`--envmap` alone: the backdrop, see
+//! [`crate::backdrop`]): errors in 8-bit codes, time per frame, the images; `--sweep` for
+//! every passes x HDR/LDR setting, `--path` for a moving object.
 
 use std::path::{Path, PathBuf};
 
 use differential_composite::gpu::{GpuCompositor, GpuSettings};
-use differential_composite::{Mode, SyntheticObject, code_error};
+use differential_composite::{MODEL_SIZE, Mode, SyntheticObject, code_error};
 use glam::Vec3;
 use real_scene::{Perturbation, RealScene};
 use shaft_hierarchy::preprocess::PreprocessSettings;
@@ -18,43 +19,92 @@ use trade::args::parse_size;
 /// The command's options.
 #[derive(clap::Args)]
 pub struct CompositeArgs {
-    /// The built-in real scene (ar_room, ar_ground).
-    #[arg(long, default_value = "ar_room")]
-    pub scene: String,
-    /// The object: a built-in (sphere, box) or a glTF model's path (.gltf, .glb), fitted into
-    /// a cube of --object-size resting on the floor at --at.
+    /// The built-in real scene (ar_room, ar_ground); the default without --envmap: ar_room.
+    #[arg(long)]
+    pub scene: Option<String>,
+    /// A user's HDR map (.exr, .hdr): without --scene, the object is composited onto it, its
+    /// lower hemisphere projected onto a ground disc (the backdrop).
+    #[arg(long)]
+    pub envmap: Option<PathBuf>,
+    /// The object: a built-in (sphere, box) or a glTF model's path (.gltf, .glb). In a built-in
+    /// scene a model is fitted into a cube of --object-size; on a backdrop it keeps its own
+    /// size (glTF's metres) unless --object-size is given.
     #[arg(long, default_value = "sphere")]
     pub object: String,
-    /// A model's size: the largest side of its bounding box, metres (built-ins keep theirs).
-    #[arg(long, default_value_t = differential_composite::MODEL_SIZE)]
-    pub object_size: f32,
-    /// The object's centre X,Y,Z in metres from the floor's centre (y up).
-    #[arg(long, default_value = "0,0.3,0.5", allow_hyphen_values = true)]
-    pub at: String,
+    /// A model's size: the largest side of its bounding box, metres (built-ins keep theirs;
+    /// in a built-in scene 0.6 m when absent).
+    #[arg(long)]
+    pub object_size: Option<f32>,
+    /// Built-in scene: the object's centre X,Y,Z from the floor's centre (default 0,0.3,0.5).
+    /// Backdrop: where the bottom of its bounding box stands (default 0,0,3: on the ground
+    /// 3 m ahead, toward the middle of the map).
+    #[arg(long, allow_hyphen_values = true)]
+    pub at: Option<String>,
+    /// Backdrop: the object's size times this.
+    #[arg(long, default_value_t = 1.0)]
+    pub scale: f32,
+    /// Backdrop: turn the object about the vertical by this many degrees.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub rotate_y: f32,
+    /// Backdrop: the camera's position X,Y,Z (with --target); by default at the map's centre of
+    /// projection, --camera-height above the ground.
+    #[arg(long, value_parser = trade::args::parse_vec3, requires = "target", allow_hyphen_values = true)]
+    pub eye: Option<Vec3>,
+    /// Backdrop: the point looked at (with --eye); by default the object's centre.
+    #[arg(long, value_parser = trade::args::parse_vec3, requires = "eye", allow_hyphen_values = true)]
+    pub target: Option<Vec3>,
+    /// Backdrop: horizontal field of view, degrees.
+    #[arg(long, default_value_t = 60.0)]
+    pub fov: f32,
+    /// Backdrop: the map's centre of projection above the ground, metres.
+    #[arg(long, default_value_t = real_scene::Backdrop::DEFAULT_CAMERA_HEIGHT)]
+    pub camera_height: f32,
+    /// Backdrop: the radius of the ground disc the map's lower half is projected onto, metres.
+    #[arg(long, default_value_t = real_scene::Backdrop::DEFAULT_GROUND_RADIUS)]
+    pub ground_radius: f32,
+    /// Backdrop: samples a pixel of the path-traced truth (it is two renders of half as many,
+    /// whose difference gives its own noise).
+    #[arg(long, default_value_t = 1024)]
+    pub truth_spp: u32,
+    /// Backdrop: samples a pixel of the path-traced shadow catcher (the offline baseline).
+    #[arg(long, default_value_t = 64)]
+    pub catcher_spp: u32,
+    /// Backdrop: the paper's hard shadow per representative instead of soft shadows over the
+    /// cone of the sources it stands for (PCSS).
+    #[arg(long)]
+    pub hard_shadows: bool,
+    /// Backdrop: the soft shadows' filter samples (the blocker search takes half as many).
+    #[arg(long, default_value_t = 16)]
+    pub pcss_samples: u32,
     /// Shadow passes (representative sources); 0: one per occluded source.
     #[arg(long, default_value_t = 50)]
     pub passes: usize,
     /// Subtract intensity transfers from the 8-bit photograph (paper 003's LDR path).
     #[arg(long)]
     pub ldr: bool,
-    /// The composite image.
+    /// The composite image (PNG; on a backdrop in HDR mode an EXR beside it too).
     #[arg(long, default_value = "target/composite/composite.png")]
     pub out: PathBuf,
-    /// One JSON object: passes, ms_per_frame, error_mae_codes, debevec_error_mae_codes,
-    /// error_rmse_codes, adapter (and more).
+    /// One JSON object: ms_per_frame, error_rmse_codes, changed_pixels, adapter and more
+    /// (on a backdrop: pathtraced_error_rmse_codes, pathtraced_ms, sources_excluded).
     #[arg(long)]
     pub json: bool,
-    /// Move the object across the floor in this many frames (from 1 m left of --at to 1 m
-    /// right): each frame's time and error against its own truth.
-    #[arg(long)]
-    pub path: Option<usize>,
-    /// Every setting: passes 1, 10, 20, 50 and all, HDR and LDR; and Figure 3.
+    /// Move the object across the ground, 1 m left of --at to 1 m right, in this many frames
+    /// (or --frames when no number is given): each frame's time (and in a built-in scene its
+    /// error against its own truth).
+    #[arg(long, num_args = 0..=1)]
+    pub path: Option<Option<usize>>,
+    /// Frames of --path.
+    #[arg(long, default_value_t = 10)]
+    pub frames: usize,
+    /// Every setting: passes 1, 10, 20, 50 and all, HDR and LDR (and Figure 3 in a built-in
+    /// scene).
     #[arg(long)]
     pub sweep: bool,
     /// Image size WIDTHxHEIGHT.
     #[arg(long, value_parser = parse_size, default_value = "320x240")]
     pub size: (u32, u32),
-    /// Samples per pixel of the photograph, the truth and Debevec's renders.
+    /// Built-in scene: samples per pixel of the photograph, the truth and Debevec's renders.
     #[arg(long, default_value_t = 32)]
     pub spp: u32,
     /// The reconstruction's reflectances times this (1: exact).
@@ -65,9 +115,9 @@ pub struct CompositeArgs {
     #[arg(long)]
     pub estimate_reflectances: bool,
     /// The shaft hierarchy's pruning: a pair below this fraction of every reached vertex's
-    /// radiance is dropped (paper: 0.02).
-    #[arg(long, default_value_t = 0.02)]
-    pub prune: f32,
+    /// radiance is dropped (built-in scenes: the paper's 0.02; backdrop: 0.002).
+    #[arg(long)]
+    pub prune: Option<f32>,
     /// Shadow-map side in texels.
     #[arg(long, default_value_t = 256)]
     pub map_resolution: u32,
@@ -82,31 +132,50 @@ pub struct CompositeArgs {
     pub adapter: Option<String>,
 }
 
+impl CompositeArgs {
+    /// The frames of `--path`, if asked for.
+    pub(crate) fn path_frames(&self) -> Option<usize> {
+        self.path.map(|n| n.unwrap_or(self.frames).max(1))
+    }
+
+    /// The GPU settings asked for.
+    pub(crate) fn gpu_settings(&self) -> Result<GpuSettings, String> {
+        let patch_maps = match self.patch_maps.as_str() {
+            "paraboloid" => shadowmap_paraboloid::Technique::DualParaboloid,
+            "cube" => shadowmap_paraboloid::Technique::Cube,
+            other => return Err(format!("--patch-maps {other:?}: paraboloid or cube")),
+        };
+        Ok(GpuSettings {
+            map_resolution: self.map_resolution,
+            shadow_detail: self.shadow_detail,
+            patch_maps,
+            layers_per_array: None,
+            pcss: None,
+            coverage_samples: 1,
+        })
+    }
+}
+
 pub(crate) fn run(args: &CompositeArgs) -> Result<(), String> {
+    if args.scene.is_none() && args.envmap.is_some() {
+        return crate::backdrop::run(args);
+    }
     let say = |s: &str| {
         if !args.json {
             outln!("{s}");
         }
     };
+    let scene_name = args.scene.as_deref().unwrap_or("ar_room");
     let e = |e: differential_composite::CompositeError| e.to_string();
-    let at = trade::args::parse_vec3(&args.at).map_err(|e| format!("--at {e}"))?;
-    let patch_maps = match args.patch_maps.as_str() {
-        "paraboloid" => shadowmap_paraboloid::Technique::DualParaboloid,
-        "cube" => shadowmap_paraboloid::Technique::Cube,
-        other => return Err(format!("--patch-maps {other:?}: paraboloid or cube")),
-    };
-    let gpu_settings = GpuSettings {
-        map_resolution: args.map_resolution,
-        shadow_detail: args.shadow_detail,
-        patch_maps,
-        layers_per_array: None,
-    };
+    let at = trade::args::parse_vec3(args.at.as_deref().unwrap_or("0,0.3,0.5")).map_err(|e| format!("--at {e}"))?;
+    let gpu_settings = args.gpu_settings()?;
     let gpu = open_gpu(args.adapter.as_deref())?;
     say(&format!("GPU: {}", gpu.describe()));
-    let probe = RealScene::builtin(&args.scene).map_err(|e| e.to_string())?;
+    let probe = RealScene::builtin(scene_name).map_err(|e| e.to_string())?;
     // the object first: a bad model is refused before the capture's minutes
     let (object, warnings) =
-        SyntheticObject::open(&args.object, probe.floor_centre() + at, args.object_size).map_err(e)?;
+        SyntheticObject::open(&args.object, probe.floor_centre() + at, args.object_size.unwrap_or(MODEL_SIZE))
+            .map_err(e)?;
     for w in warnings {
         eprintln!("warning: {}: {w}", args.object);
     }
@@ -118,16 +187,19 @@ pub(crate) fn run(args: &CompositeArgs) -> Result<(), String> {
         reconstruction: Perturbation { reflectance_scale: args.reflectance_scale, ..Perturbation::NONE },
         estimate_reflectances: args.estimate_reflectances,
         preprocess: PreprocessSettings {
-            hierarchy: shaft_hierarchy::Settings { prune_fraction: args.prune, ..shaft_hierarchy::Settings::PAPER },
+            hierarchy: shaft_hierarchy::Settings {
+                prune_fraction: args.prune.unwrap_or(0.02),
+                ..shaft_hierarchy::Settings::PAPER
+            },
             ..PreprocessSettings::PAPER
         },
     };
     let t = std::time::Instant::now();
-    let session = Session::new(&args.scene, map, lights, &settings).map_err(e)?;
+    let session = Session::new(scene_name, map, lights, &settings).map_err(e)?;
     let c = &session.compositor;
     say(&format!(
         "{}: {} x {}, photograph {} spp, {} sources, {} receivers; reconstruction with reflectances x {}{}, pruning {} ({:.1} s)",
-        args.scene,
+        scene_name,
         args.size.0,
         args.size.1,
         args.spp,
@@ -135,13 +207,13 @@ pub(crate) fn run(args: &CompositeArgs) -> Result<(), String> {
         c.prepared.receivers.len(),
         args.reflectance_scale,
         if args.estimate_reflectances { ", then estimated from the capture" } else { "" },
-        args.prune,
+        args.prune.unwrap_or(0.02),
         t.elapsed().as_secs_f64()
     ));
     let gc = GpuCompositor::new(&gpu, c).map_err(|e| e.to_string())?;
     let mode = if args.ldr { Mode::Ldr } else { Mode::Hdr };
-    if let Some(frames) = args.path {
-        return moving(args, (&gpu, &gc, &gpu_settings), &session, (&object, at, frames.max(1)), mode);
+    if let Some(frames) = args.path_frames() {
+        return moving(args, (&gpu, &gc, &gpu_settings), &session, (&object, at, frames), mode);
     }
     let t = std::time::Instant::now();
     let truth = session.truth(&object).map_err(e)?;
@@ -150,16 +222,9 @@ pub(crate) fn run(args: &CompositeArgs) -> Result<(), String> {
     let deb = code_error(&debevec, &truth, &c.photo_ldr);
     let passes: Vec<usize> = if args.sweep { vec![1, 10, 20, 50, 0] } else { vec![args.passes] };
     let modes: Vec<Mode> = if args.sweep { vec![Mode::Hdr, Mode::Ldr] } else { vec![mode] };
-    let table =
-        rows(&gpu, &gc, &session, &object, &truth, &passes, &modes, &gpu_settings, 5).map_err(|e| e.to_string())?;
+    let table = rows(&gpu, &gc, c, &object, &truth, &passes, &modes, &gpu_settings, 5).map_err(|e| e.to_string())?;
     let (w, h) = args.size;
-    let save = |path: &Path, img: &[[u8; 3]]| {
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-        }
-        envmap_sphere::io::save_png_srgb8(path, w, h, &img.iter().flatten().copied().collect::<Vec<u8>>())
-            .map_err(|e| e.to_string())
-    };
+    let save = |path: &Path, img: &[[u8; 3]]| save_png(path, (w, h), img);
     let beside = |suffix: &str| -> PathBuf {
         let stem = args.out.file_stem().map_or_else(|| "composite".into(), |s| s.to_string_lossy().to_string());
         args.out.with_file_name(format!("{stem}_{suffix}.png"))
@@ -172,19 +237,13 @@ pub(crate) fn run(args: &CompositeArgs) -> Result<(), String> {
     save(&beside("error"), &differential_composite::metrics::error_image(&main.image, &truth))?;
     if args.json {
         let v = serde_json::json!({
-            "scene": args.scene,
+            "scene": scene_name,
             "object": args.object,
             "at": at.to_array(),
             "passes": main.passes,
             "representatives": main.reps,
             "occluded_sources": main.occluded_sources,
             "mode": main.mode_label().to_lowercase(),
-            "ms_per_frame": ms(main.times.total()),
-            "ms_cpu": ms(main.times.cpu),
-            "ms_gbuffer": ms(main.times.gbuffer),
-            "ms_shadow_maps": ms(main.times.shadow_maps),
-            "ms_masks": ms(main.times.masks),
-            "ms_resolve": ms(main.times.resolve),
             "error_mae_codes": main.error.mae_changed,
             "error_rmse_codes": main.error.rmse_changed,
             "error_mae_codes_image": main.error.mae,
@@ -196,10 +255,10 @@ pub(crate) fn run(args: &CompositeArgs) -> Result<(), String> {
             "spp": args.spp,
             "reflectance_scale": args.reflectance_scale,
             "estimate_reflectances": args.estimate_reflectances,
-            "prune": args.prune,
+            "prune": args.prune.unwrap_or(0.02),
             "adapter": gpu.info.name,
         });
-        outln!("{v}");
+        print_json(v, main);
         return Ok(());
     }
     outln!(
@@ -290,7 +349,7 @@ fn moving(
 /// The GPU: `--adapter`, else `ENVSHADOW_ADAPTER`, else the best adapter present. Without any
 /// adapter, says how to get a software one (`cargo xtask test` installs it; a user tool
 /// installs nothing).
-fn open_gpu(adapter: Option<&str>) -> Result<gpu::Gpu, String> {
+pub(crate) fn open_gpu(adapter: Option<&str>) -> Result<gpu::Gpu, String> {
     let opened = match adapter {
         Some(name) => gpu::Gpu::with_adapter(Some(name)),
         None => gpu::Gpu::new(),
@@ -301,4 +360,21 @@ fn open_gpu(adapter: Option<&str>) -> Result<gpu::Gpu, String> {
         ),
         other => other.to_string(),
     })
+}
+
+/// Writes an 8-bit image (row-major RGB), creating its folder; the error names the file.
+pub(crate) fn save_png(path: &Path, (w, h): (u32, u32), img: &[[u8; 3]]) -> Result<(), String> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    }
+    envmap_sphere::io::save_png_srgb8(path, w, h, &img.iter().flatten().copied().collect::<Vec<u8>>())
+        .map_err(|e| e.to_string())
+}
+
+/// Prints one command's JSON object with `row`'s times added.
+pub(crate) fn print_json(mut v: serde_json::Value, row: &trade::composite_rows::Row) {
+    if let Some(o) = v.as_object_mut() {
+        o.extend(row.times_json());
+    }
+    outln!("{v}");
 }

@@ -13,6 +13,7 @@ macro_rules! outln {
     }};
 }
 
+mod backdrop;
 mod composite;
 mod extract;
 mod info;
@@ -92,7 +93,9 @@ enum Command {
     /// --ldr, intensity transfers in 8-bit codes. Writes OUT (and OUT_photo, _truth, _debevec,
     /// _error beside it) and prints the error in codes against the path-traced truth and
     /// Debevec's offline differential rendering, and the time per frame.
-    #[command(after_help = "Example: envshadow composite --scene ar_ground --object model.glb --out composite.png")]
+    #[command(
+        after_help = "Examples:\n  envshadow composite --envmap my_hdri.exr --object model.glb --out composite.png\n  envshadow composite --scene ar_ground --object model.glb --out composite.png"
+    )]
     Composite(composite::CompositeArgs),
     /// Print an environment map's size, format, luminance, power and SH9 coefficients.
     #[command(after_help = "Example: envshadow info map.exr --json")]

@@ -469,3 +469,54 @@ fn bad_models_exit_one_with_one_line_naming_the_file() {
         assert!(err.contains(p) && err.contains(why), "{p}: wanted {why:?} in {err}");
     }
 }
+
+#[test]
+fn composite_onto_a_map_has_the_interface_keys_and_refuses_bad_input() {
+    let dir = fresh_dir("cli-backdrop");
+    let cube = write_cube_gltf(&dir);
+    let cube = cube.to_str().unwrap_or_default();
+    let map = shared("courtyard.exr");
+    let map = map.to_str().unwrap_or_default();
+    let out = dir.join("b.png");
+    let small = ["--size", "48x36", "--truth-spp", "16", "--catcher-spp", "4", "--passes", "10"];
+    let run = envshadow(
+        &[
+            &["composite", "--envmap", map, "--object", cube, "--at", "0.2,0,3"][..],
+            &small,
+            &["--out", out.to_str().unwrap_or_default(), "--json"],
+        ]
+        .concat(),
+    );
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let text = String::from_utf8_lossy(&run.stdout);
+    assert_eq!(text.trim().lines().count(), 1, "one JSON object on one line: {text}");
+    let v: serde_json::Value = serde_json::from_str(&text).expect("valid JSON");
+    for k in ["ms_per_frame", "error_rmse_codes", "pathtraced_error_rmse_codes", "pathtraced_ms", "changed_pixels"] {
+        assert!(v.get(k).is_some_and(serde_json::Value::is_number), "missing number {k} in {v}");
+    }
+    assert!(v["sources_excluded"].is_u64() && v["adapter"].as_str().is_some_and(|a| !a.is_empty()), "{v}");
+    assert!(v["changed_pixels"].as_u64().unwrap_or(0) > 20, "the cube changes the image: {v}");
+    assert!(v["sources_excluded"].as_u64() <= v["sources"].as_u64(), "{v}");
+    // the camera looks at the cube from the map's centre of projection, 1.6 m up
+    let eye: Vec<f64> =
+        v["eye"].as_array().map(|a| a.iter().filter_map(serde_json::Value::as_f64).collect()).unwrap_or_default();
+    assert!(eye.len() == 3 && eye[0] == 0.0 && (eye[1] - 1.6).abs() < 1e-6 && eye[2] == 0.0, "{v}");
+    for f in ["b.png", "b.exr", "b_plate.png", "b_truth.png", "b_truth.exr", "b_catcher.png", "b_error.png"] {
+        assert!(dir.join(f).is_file(), "{f} missing");
+    }
+    // a missing map, a camera under the ground, a bad model, a bad height: one line, exit 1
+    let missing = dir.join("missing.exr");
+    let cases: [(&[&str], &str); 4] = [
+        (&["--envmap", missing.to_str().unwrap_or_default()], "missing.exr"),
+        (&["--envmap", map, "--eye", "0,-1,0", "--target", "0,0,3"], "not above the ground"),
+        (&["--envmap", map, "--object", "teapot"], "teapot"),
+        (&["--envmap", map, "--camera-height", "0"], "camera height"),
+    ];
+    for (bad, want) in cases {
+        let run = envshadow(&[&["composite"][..], bad, &small].concat());
+        assert_eq!(run.status.code(), Some(1), "{bad:?}");
+        let err = String::from_utf8_lossy(&run.stderr);
+        let lines: Vec<&str> = err.lines().filter(|l| !l.contains("XDG_RUNTIME_DIR")).collect();
+        assert!(lines.len() == 1 && lines[0].contains(want), "{bad:?}: {err}");
+    }
+}

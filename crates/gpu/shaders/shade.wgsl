@@ -112,12 +112,18 @@ fn material_at(m: Material, uv: vec2<f32>) -> Material {
     }
     var out = m;
     let base = clamp(m.base_metallic.rgb * sample_texture(m.maps.x, uv, true).rgb, vec3<f32>(0.0), vec3<f32>(1.0));
+    out.emission = vec4<f32>(m.emission.rgb * sample_texture(m.maps.z, uv, true).rgb, 0.0);
+    // `Maps::specular` false: the base colour alone, Lambertian
+    if m.pbr.z > 0.5 {
+        out.albedo = vec4<f32>(base, 0.0);
+        out.f0_roughness = vec4<f32>(0.0, 0.0, 0.0, 1.0);
+        return out;
+    }
     let mr = sample_texture(m.maps.y, uv, false);
     let metallic = clamp(m.base_metallic.a * mr.b, 0.0, 1.0);
     let roughness = max(clamp(m.pbr.x * mr.g, 0.0, 1.0), MIN_ROUGHNESS);
     out.albedo = vec4<f32>(base * (1.0 - metallic), 1.0);
     out.f0_roughness = vec4<f32>(mix(vec3<f32>(0.04), base, metallic), roughness);
-    out.emission = vec4<f32>(m.emission.rgb * sample_texture(m.maps.z, uv, true).rgb, 0.0);
     return out;
 }
 

@@ -40,7 +40,8 @@ pub(crate) struct GpuMaterial {
     emission: [f32; 4],
     /// rgb base colour factor, a metallic factor
     base_metallic: [f32; 4],
-    /// x roughness factor, y 1 where textured
+    /// x roughness factor, y 1 where textured, z 1 where the textured material has no
+    /// specular layer (Lambertian base colour)
     pbr: [f32; 4],
     /// base colour, metallic-roughness and emissive texture (`NO_TEXTURE`: none)
     maps: [u32; 4],
@@ -61,7 +62,7 @@ impl GpuMaterial {
         if let Some(maps) = m.maps {
             let b = maps.base_color;
             out.base_metallic = [b.x, b.y, b.z, maps.metallic];
-            out.pbr = [maps.roughness, 1.0, 0.0, 0.0];
+            out.pbr = [maps.roughness, 1.0, if maps.specular { 0.0 } else { 1.0 }, 0.0];
             let t = |t: Option<u32>| t.unwrap_or(NO_TEXTURE);
             out.maps = [t(maps.base_color_texture), t(maps.metallic_roughness_texture), t(maps.emissive_texture), 0];
             out.emission = [maps.emissive.x, maps.emissive.y, maps.emissive.z, 0.0];

@@ -24,7 +24,7 @@ fn quad(z: f32, half: f32, away: bool) -> Mesh {
     Mesh { positions: positions.to_vec(), normals: None, indices, uvs: Some(uvs.to_vec()) }
 }
 
-fn textured_scene() -> Scene {
+fn textured_scene(specular: bool) -> Scene {
     let maps = Maps {
         base_color: Vec3::new(0.9, 0.8, 0.7),
         metallic: 1.0,
@@ -33,6 +33,7 @@ fn textured_scene() -> Scene {
         base_color_texture: Some(0),
         metallic_roughness_texture: Some(1),
         emissive_texture: Some(2),
+        specular,
     };
     let material = Material { maps: Some(maps), double_sided: false, ..Material::lambert(0.5) };
     let base = texture([Wrap::Mirror, Wrap::Clamp], Filter::Linear, |x, y| {
@@ -59,8 +60,19 @@ fn textured_scene() -> Scene {
 
 #[test]
 fn textured_material_shades_as_ref_tracer() {
+    shades_as_ref_tracer(true);
+}
+
+/// A textured material without its specular layer (a backdrop's ground): the base colour
+/// alone, Lambertian, on both renderers.
+#[test]
+fn lambertian_textured_material_shades_as_ref_tracer() {
+    shades_as_ref_tracer(false);
+}
+
+fn shades_as_ref_tracer(specular: bool) {
     let gpu = gpu();
-    let scene = textured_scene();
+    let scene = textured_scene(specular);
     let light =
         DistantLight { direction: Vec3::new(0.3, 0.4, 1.0).normalize(), solid_angle: 1e-5, radiance: Vec3::splat(2e5) };
     let lights = [light];
@@ -118,7 +130,7 @@ fn textured_material_shades_as_ref_tracer() {
 #[test]
 fn one_sided_back_faces_are_culled_as_ref_tracer_culls_them() {
     let gpu = gpu();
-    let mut scene = textured_scene();
+    let mut scene = textured_scene(true);
     // in front of the textured quad, turned away from the camera: culled, so the quad behind shows
     let blocker = Object {
         name: "blocker".into(),

@@ -9,11 +9,13 @@
 //! object per patch of [`RealScene::to_scene`]), so nothing here depends on how rays are traced:
 //! `ref_tracer::SceneBvh` answers it.
 
+pub mod backdrop;
 mod builtin;
 pub mod formfactor;
 mod photo;
 mod radiosity;
 
+pub use backdrop::Backdrop;
 pub use builtin::{BUILTIN_REAL_SCENES, Perturbation};
 pub use photo::CameraResponse;
 pub use radiosity::{SolveReport, SolveSettings, estimate_reflectances, solve};
@@ -160,4 +162,7 @@ pub enum RealSceneError {
         "{0}: the environment map and the scene's lighting disagree (environment-lit scenes need one, others take none)"
     )]
     NeedsEnvironment(String),
+    /// A parameter out of its range (a backdrop's height or radius, a camera below the ground).
+    #[error("{0}")]
+    Parameter(String),
 }

@@ -898,6 +898,7 @@ impl Importer<'_> {
                 base_color_texture: load(base_tex)?,
                 metallic_roughness_texture: load(mr_tex)?,
                 emissive_texture: load(emissive_tex)?,
+                specular: true,
             };
             material.maps = Some(maps);
         }

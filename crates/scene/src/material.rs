@@ -33,6 +33,10 @@ pub struct Maps {
     pub metallic_roughness_texture: Option<u32>,
     /// `emissiveTexture` (sRGB; RGB multiplies the factor).
     pub emissive_texture: Option<u32>,
+    /// glTF's specular layer (a dielectric's 4 %, a metal's base colour); `false`: the base
+    /// colour alone as a Lambertian albedo, metallic and roughness unused (a backdrop's ground,
+    /// whose reflectance is estimated from a photograph as radiance over irradiance).
+    pub specular: bool,
 }
 
 /// Smallest perceptual roughness a GGX layer takes (alpha 1e-3, the shaders' floor): glTF
@@ -91,9 +95,13 @@ impl Material {
             t.and_then(|k| textures.get(k as usize)).map_or(glam::Vec4::ONE, |t| t.sample(uv, srgb))
         };
         let base = m.base_color * sample(m.base_color_texture, true).truncate();
+        let emission = m.emissive * sample(m.emissive_texture, true).truncate();
+        if !m.specular {
+            let albedo = base.to_array().map(|v| if v.is_finite() { v.clamp(0.0, 1.0) } else { 0.0 }).into();
+            return Self { albedo, specular: None, emission, double_sided: self.double_sided, maps: None };
+        }
         let mr = sample(m.metallic_roughness_texture, false);
         let (albedo, ggx) = Self::metallic_roughness(base, m.metallic * mr.z, m.roughness * mr.y);
-        let emission = m.emissive * sample(m.emissive_texture, true).truncate();
         Self { albedo, specular: Some(ggx), emission, double_sided: self.double_sided, maps: None }
     }
 

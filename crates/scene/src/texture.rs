@@ -74,6 +74,15 @@ pub fn srgb_to_linear(c: f32) -> f32 {
     if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
 }
 
+/// A linear value in [0, 1] as the nearest 8-bit sRGB code (IEC 61966-2-1); values outside
+/// are clamped, NaN reads 0.
+#[must_use]
+pub fn linear_to_srgb8(c: f32) -> u8 {
+    let c = if c.is_nan() { 0.0 } else { c.clamp(0.0, 1.0) };
+    let s = if c <= 0.003_130_8 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 };
+    (s * 255.0).round().clamp(0.0, 255.0) as u8
+}
+
 impl Texture {
     /// Texel `(x, y)` as linear values in [0, 1]: its RGB through the sRGB curve when `srgb`
     /// (base colour and emission), as stored otherwise (metallic-roughness); alpha as stored.
@@ -143,6 +152,38 @@ impl Texture {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn srgb8_round_trips_every_code() {
+        for code in 0..=255u8 {
+            assert_eq!(linear_to_srgb8(srgb_to_linear(f32::from(code) / 255.0)), code);
+        }
+        assert_eq!((linear_to_srgb8(-1.0), linear_to_srgb8(2.0), linear_to_srgb8(f32::NAN)), (0, 255, 0));
+    }
+
+    #[test]
+    fn lambertian_maps_give_the_base_colour_alone() {
+        let t = checker();
+        let maps = crate::Maps {
+            base_color: glam::Vec3::new(0.5, 1.0, 1.0),
+            metallic: 1.0,
+            roughness: 0.2,
+            emissive: glam::Vec3::ZERO,
+            base_color_texture: Some(0),
+            metallic_roughness_texture: None,
+            emissive_texture: None,
+            specular: false,
+        };
+        let m = crate::Material { maps: Some(maps), ..crate::Material::lambert(0.3) };
+        let uv = Vec2::new(0.1, 0.1);
+        let at = m.at(std::slice::from_ref(&t), uv);
+        let texel = t.sample(uv, true).truncate();
+        assert!(at.specular.is_none() && (at.albedo - texel * maps.base_color).abs().max_element() < 1e-6);
+        // with the layer, a metal of that colour
+        let layered = crate::Material { maps: Some(crate::Maps { specular: true, ..maps }), ..m };
+        let at = layered.at(std::slice::from_ref(&t), uv);
+        assert!(at.specular.is_some() && at.albedo.max_element() < 1e-6);
+    }
 
     fn checker() -> Texture {
         // 2 x 2: black, white / white, black

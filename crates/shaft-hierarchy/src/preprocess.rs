@@ -51,11 +51,15 @@ pub struct PreprocessSettings {
     pub visibility_samples: u32,
     /// The hierarchy's knobs.
     pub hierarchy: Settings,
+    /// Whether the scene's patches are candidate sources (the paper's); without, the distant
+    /// lights alone are (a backdrop's ground lights nothing the compositor darkens).
+    pub patch_sources: bool,
 }
 
 impl PreprocessSettings {
     /// The paper's: 70 % of the power, 8 receivers a leaf, 2 % pruning; 2 x 2 visibility rays.
-    pub const PAPER: Self = Self { source_share: 0.7, visibility_samples: 2, hierarchy: Settings::PAPER };
+    pub const PAPER: Self =
+        Self { source_share: 0.7, visibility_samples: 2, hierarchy: Settings::PAPER, patch_sources: true };
 }
 
 impl Default for PreprocessSettings {
@@ -104,6 +108,7 @@ pub fn prepare(
         .iter()
         .enumerate()
         .map(|(k, p)| (Source::Patch(k as u32), f64::from(p.power())))
+        .filter(|_| settings.patch_sources)
         .chain(lights.iter().enumerate().map(|(k, l)| (Source::Distant(k as u32), delivered_power(scene, l))))
         .filter(|(_, w)| *w > 0.0 && w.is_finite())
         .collect();

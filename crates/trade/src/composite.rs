@@ -102,7 +102,7 @@ pub fn measure_composite(
         let row = crate::composite_rows::rows(
             gpu,
             &case.compositor,
-            &case.session,
+            &case.session.compositor,
             &case.object,
             &case.truth,
             &[setting.passes],

@@ -9,7 +9,7 @@ use gpu::{Gpu, GpuError};
 use differential_composite::compositor::FrameTransfers;
 use differential_composite::gpu::{FrameTimes, GpuCompositor, GpuSettings, MapWork};
 use differential_composite::ldr::Dataset;
-use differential_composite::{CodeError, Mode, SyntheticObject, code_error};
+use differential_composite::{CodeError, Compositor, Mode, SyntheticObject, code_error};
 
 use crate::session::Session;
 
@@ -47,6 +47,24 @@ impl Row {
         if self.mode == Mode::Ldr { "LDR" } else { "HDR" }
     }
 
+    /// The frame's times as the commands' JSON gives them: `ms_per_frame` and each stage's
+    /// `ms_*`.
+    #[must_use]
+    pub fn times_json(&self) -> serde_json::Map<String, serde_json::Value> {
+        let [total, cpu, gbuffer, maps, masks, resolve] = self.times_ms();
+        [
+            ("ms_per_frame", total),
+            ("ms_cpu", cpu),
+            ("ms_gbuffer", gbuffer),
+            ("ms_shadow_maps", maps),
+            ("ms_masks", masks),
+            ("ms_resolve", resolve),
+        ]
+        .into_iter()
+        .map(|(k, v)| (k.to_string(), serde_json::json!(v)))
+        .collect()
+    }
+
     /// The frame's times in milliseconds: total, CPU, G-buffer, maps, masks, resolve.
     #[must_use]
     pub fn times_ms(&self) -> [f64; 6] {
@@ -64,7 +82,7 @@ impl Row {
 pub fn rows(
     gpu: &Gpu,
     gc: &GpuCompositor,
-    session: &Session,
+    c: &Compositor,
     object: &SyntheticObject,
     truth: &[[u8; 3]],
     passes: &[usize],
@@ -72,7 +90,6 @@ pub fn rows(
     settings: &GpuSettings,
     repeats: usize,
 ) -> Result<Vec<Row>, GpuError> {
-    let c = &session.compositor;
     let mut out = Vec::new();
     for &n in passes {
         for &mode in modes {

@@ -19,6 +19,7 @@
 //! no printing, progress goes to a callback.
 
 pub mod args;
+pub mod backdrop;
 pub mod banding;
 pub mod capture;
 pub mod composite;
@@ -37,6 +38,7 @@ pub mod stages;
 pub mod table;
 pub mod techniques;
 
+pub use backdrop::{BackdropSession, BackdropSettings};
 pub use banding::{BandingCase, BandingRow, Interleave, measure_banding};
 pub use capture::{PhotoSettings, photograph, photograph_with};
 pub use composite::{CompositeCase, measure_composite};

@@ -51,7 +51,7 @@ pub(super) fn run(gpu: &Gpu, quick: bool) -> Result<Compositing, String> {
     let table = rows(
         gpu,
         &gc,
-        &session,
+        &session.compositor,
         &object,
         &truth,
         &[1, 10, 20, 50, 0],
