@@ -39,7 +39,9 @@ struct Cli {
 enum Command {
     /// Write a built-in scene (spheres_box, three_boxes, column, glossy_set, room, gallery) as
     /// Wavefront OBJ or glTF 2.0, for another renderer or to start a model of one's own from.
-    #[command(after_help = "Example: envshadow scene room --gltf room.glb --obj room.obj")]
+    #[command(
+        after_help = "Examples:\n  envshadow scene room --gltf room.glb --obj room.obj\n  envshadow scene spheres_box --without-ground --gltf objects.glb"
+    )]
     Scene {
         /// The scene's name.
         name: String,
@@ -50,6 +52,9 @@ enum Command {
         /// reads back as the same scene: camera, lights and GGX layers included.
         #[arg(long)]
         gltf: Option<PathBuf>,
+        /// Leave its ground out: its objects alone, a model to composite (`composite --object`).
+        #[arg(long)]
+        without_ground: bool,
     },
     /// Render a built-in scene or a glTF model with the CPU reference tracer: OUT.exr, a tone-mapped OUT.png,
     /// and with --aovs OUT.albedo.exr, OUT.normal.exr, OUT.depth.exr, OUT.object.exr.
@@ -121,7 +126,9 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Info { path, json } => info::run(&path, json),
         Command::Composite(args) => composite::run(&args),
-        Command::Scene { name, obj, gltf } => scene::run(&name, obj.as_deref(), gltf.as_deref()),
+        Command::Scene { name, obj, gltf, without_ground } => {
+            scene::run(&name, obj.as_deref(), gltf.as_deref(), without_ground)
+        }
         Command::Render(args) => render::run(&args),
         Command::Compare { reference, test } => render::compare(&reference, &test),
         Command::Extract { path, method, lights, out, lux_per_unit } => {
