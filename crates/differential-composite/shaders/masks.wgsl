@@ -38,6 +38,9 @@ struct PixelRef {
 @group(0) @binding(3) var<storage, read> maps: array<MapParams>;
 @group(0) @binding(4) var shadow_maps: texture_depth_2d_array;
 @group(0) @binding(5) var<storage, read_write> darkening: array<vec4<f32>>;
+// per representative of the batch, the pixels (x0, y0, x1, y1; ends excluded) its shadow can
+// reach (`gpu::shadow_rect`; the whole image where not culled)
+@group(0) @binding(6) var<storage, read> rects: array<vec4<u32>>;
 
 // Vogel-disk sample k of n at radius 1, turned by `spin` radians.
 fn vogel(k: u32, n: u32, spin: f32) -> vec2<f32> {
@@ -124,6 +127,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let ng = px.normal.xyz;
     var sum = vec4<f32>(0.0);
     for (var r = 0u; r < params.reps; r++) {
+        let rect = rects[r];
+        if id.x < rect.x || id.y < rect.y || id.x >= rect.z || id.y >= rect.w {
+            continue;
+        }
         let base = (params.first_rep + r) * params.slots + px.slot;
         let t = px.weights.x * transfers[base] + px.weights.y * transfers[base + 1u]
             + px.weights.z * transfers[base + 2u] + px.weights.w * transfers[base + 3u];

@@ -344,16 +344,18 @@ impl Compositor {
         let shading = t.elapsed();
         let t = Instant::now();
         if self.object_replaces_sources {
-            // the object's side that stands in a source's place faces receivers, which it
-            // shadows: its light from the sky alone (the ground under it is in its shadow)
-            let sky = self.sky_irradiance_at(object.centre);
-            let lit =
-                FrameTransfers { object_irradiance: sky, object_lights: object_lights.clone(), ..Default::default() };
+            // the object's side that stands in a source's place faces the receivers below the
+            // sources: seen from high sources' receivers, under the object, it faces ground in
+            // its own shadow (its light from the sky alone); from low ones', the lit ground
+            // beyond (all of its light): blended by the source's elevation
+            let full = FrameTransfers { object_irradiance, object_lights: object_lights.clone(), ..Default::default() };
+            let sky = FrameTransfers { object_irradiance: self.sky_irradiance_at(object.centre), ..full.clone() };
             for rep in &mut out {
                 let Origin::Direction(d) = rep.origin else { continue };
-                // the object's radiance facing the receivers below the sources, in their place
                 let sources = rep.source_radiance;
-                let own = object.albedo / std::f32::consts::PI * lit.object_irradiance_at(-d).max(Vec3::ZERO);
+                let facing = |f: &FrameTransfers| f.object_irradiance_at(-d).max(Vec3::ZERO);
+                let e = facing(&full).lerp(facing(&sky), d.y.clamp(0.0, 1.0));
+                let own = object.albedo / std::f32::consts::PI * e;
                 let keep = Vec3::from_array(std::array::from_fn(|c| {
                     if sources[c] > 0.0 { (1.0 - own[c] / sources[c]).clamp(0.0, 1.0) } else { 1.0 }
                 }));

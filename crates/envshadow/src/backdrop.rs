@@ -35,6 +35,7 @@ pub(crate) fn run(args: &CompositeArgs) -> Result<(), String> {
             max_radius_texels: 64.0,
         }),
         coverage_samples: 2,
+        cull_masks: true,
         ..args.gpu_settings()?
     };
     // the inputs first: a bad map, model or camera is refused before the GPU and the renders

@@ -152,6 +152,7 @@ impl CompositeArgs {
             layers_per_array: None,
             pcss: None,
             coverage_samples: 1,
+            cull_masks: false,
         })
     }
 }

@@ -62,19 +62,26 @@ fn sphere(at: Vec3, scale: f32) -> SyntheticObject {
 /// The GPU composite (HDR, 50 passes, soft shadows, 2 x 2 coverage) and the truth at `spp`,
 /// both in radiance.
 fn run(session: &BackdropSession, object: &SyntheticObject, spp: u32) -> (Vec<Vec3>, Vec<Vec3>) {
+    let ours = composite(session, object, true).1;
+    let (truth, _) = session.differential(object, spp, 3);
+    assert!(ours.iter().chain(&truth).all(|v| v.is_finite() && v.min_element() >= 0.0), "a NaN or a negative");
+    (ours, truth)
+}
+
+/// The GPU composite as the command draws it (HDR, 50 passes, soft shadows, 2 x 2 coverage),
+/// its masks culled or not: the 8-bit image and the radiance.
+fn composite(session: &BackdropSession, object: &SyntheticObject, cull_masks: bool) -> (Vec<[u8; 3]>, Vec<Vec3>) {
     let c = &session.compositor;
     let gc = GpuCompositor::new(gpu(), c).unwrap_or_else(|e| panic!("{e}"));
     let settings = GpuSettings {
         pcss: Some(shadowmap_paraboloid::Pcss { blocker_samples: 8, filter_samples: 16, max_radius_texels: 64.0 }),
         coverage_samples: 2,
+        cull_masks,
         ..GpuSettings::default()
     };
     let frame = c.frame(object, 50);
-    gc.composite(gpu(), c, &frame, object, Mode::Hdr, &settings).unwrap_or_else(|e| panic!("{e}"));
-    let ours = gc.read_output_hdr(gpu()).unwrap_or_else(|e| panic!("{e}"));
-    let (truth, _) = session.differential(object, spp, 3);
-    assert!(ours.iter().chain(&truth).all(|v| v.is_finite() && v.min_element() >= 0.0), "a NaN or a negative");
-    (ours, truth)
+    let (image, _, _) = gc.composite(gpu(), c, &frame, object, Mode::Hdr, &settings).unwrap_or_else(|e| panic!("{e}"));
+    (image, gc.read_output_hdr(gpu()).unwrap_or_else(|e| panic!("{e}")))
 }
 
 /// Per ground pixel the object does not cover: its ground point and how much of the plate's
@@ -224,4 +231,29 @@ fn an_object_larger_than_the_disc_composites() {
     let e = differential_composite::code_error(&codes(&ours), &codes(&truth), &c.photo_ldr);
     assert!(e.changed > (SIZE.0 * SIZE.1 / 4) as usize, "it fills the view: {} pixels changed", e.changed);
     assert!(e.rmse_changed < 20.0, "RMSE {} codes", e.rmse_changed);
+}
+
+#[test]
+fn culled_masks_draw_the_same_image() {
+    // a sun low in the side, its shadow long across the view, and an overcast sky: every
+    // representative tested only inside its rectangle gives the image testing all of them does
+    let at = Vec3::new(0.3, 0.0, 2.5);
+    for sun in [Some((Vec3::new(-1.0, 0.4, 0.3).normalize(), 3e3)), None] {
+        let s = BackdropSession::new(map(sun), camera(Vec3::new(0.0, 1.6, 0.0), at), &settings(20.0)).unwrap();
+        for object in [sphere(at, 1.0), sphere(at + Vec3::Y * 0.5, 2.0)] {
+            let frame = s.compositor.frame(&object, 50);
+            let bounds = object.bounds();
+            let culled: usize = frame
+                .reps
+                .iter()
+                .map(|r| {
+                    let [x0, y0, x1, y1] = differential_composite::gpu::shadow_rect(&s.compositor, &bounds, r);
+                    (SIZE.0 * SIZE.1) as usize - (x1.saturating_sub(x0) * y1.saturating_sub(y0)) as usize
+                })
+                .sum();
+            assert!(culled > 0, "{sun:?}: nothing culled");
+            let (a, b) = (composite(&s, &object, true), composite(&s, &object, false));
+            assert!(a.0 == b.0 && a.1 == b.1, "{sun:?}: the culled masks changed the image");
+        }
+    }
 }
