@@ -146,7 +146,8 @@ impl BackdropSession {
         let response = CameraResponse::auto(&plate);
         let bvh = SceneBvh::new(&model.to_scene());
         let built = build(&model, &lights, &bvh, &settings.preprocess)?;
-        let rays = Box::new(SceneBvh::new(&model.to_scene()));
+        // the compositor's own ray queries: the BVH the pre-process used
+        let rays = Box::new(bvh);
         // each receiver pixel's own reflectance, from the ground point its centre ray meets
         let e = Backdrop::ground_irradiance(&map);
         let camera_rays = camera.rays();

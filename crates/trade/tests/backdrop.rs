@@ -165,8 +165,6 @@ fn sun_on_the_horizon_shadows_reach_the_disc_edge() {
         let down = mean(&|p: Vec3| (-5.0..-4.0).contains(&p.x) && p.z.abs() < 0.15);
         let side = mean(&|p: Vec3| (-5.0..-4.0).contains(&p.x) && (1.0..2.0).contains(&p.z));
         // the sun, 2 degrees up, gives the ground about half its light there
-        let plate: Vec<f32> = d.iter().filter(|x| (-5.0..-4.0).contains(&x.0.x)).map(|x| x.1).collect();
-        let _ = plate;
         assert!(down > 0.02 && down > 8.0 * side.max(0.0), "{name}: {down} down the shadow, {side} beside it");
     }
 }
@@ -191,12 +189,10 @@ fn a_floating_objects_shadow_weakens_as_the_truths() {
     let s = BackdropSession::new(map(None), camera(Vec3::new(0.0, 2.0, 0.0), at), &settings(20.0)).unwrap();
     // the darkest of the shadow within 1.2 m of the axis: the mean of its 30 darkest pixels,
     // as a fraction of the plate
-    let plate = |k: usize| luminance(s.compositor.photo_hdr[k]);
     let near = |image: &[Vec3], object: &SyntheticObject| {
         let d = darkening(&s, image, object);
         let mut v: Vec<f32> =
             d.iter().filter(|x| Vec3::new(x.0.x - at.x, 0.0, x.0.z - at.z).length() < 1.2).map(|x| x.1).collect();
-        let _ = plate;
         v.sort_by(|a, b| b.total_cmp(a));
         v.iter().take(30).sum::<f32>() / 30.0
     };
