@@ -15,7 +15,7 @@ struct Params {
     light_count: u32,
     pad1: u32,
     pad2: u32,
-    // x exposure, y 1 / gamma, z white
+    // x exposure, y 1 / gamma, z white, w the photograph's clip level (0: none)
     response: vec4<f32>,
     // the object's albedo / pi
     albedo: vec4<f32>,
@@ -50,6 +50,14 @@ fn object_irradiance(n: vec3<f32>) -> vec3<f32> {
 fn codes(l: vec3<f32>) -> vec3<f32> {
     let x = max(l * params.response.x / params.response.z, vec3<f32>(0.0));
     return 255.0 * pow(min(x, vec3<f32>(1.0)), vec3<f32>(params.response.y));
+}
+
+// the camera's clip where the photograph has one (`Compositor::clip`)
+fn clipped(l: vec4<f32>) -> vec4<f32> {
+    if params.response.w > 0.0 {
+        return vec4<f32>(min(l.rgb, vec3<f32>(params.response.w)), l.a);
+    }
+    return l;
 }
 
 fn pack(c: vec3<f32>) -> u32 {
@@ -87,22 +95,22 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         object /= f32(covered);
     }
     if alpha == 1.0 {
-        out_hdr[k] = vec4<f32>(object, 1.0);
+        out_hdr[k] = clipped(vec4<f32>(object, 1.0));
         out[k] = pack(codes(object));
         return;
     }
     let d = darkening[k].rgb * pixel_scale[k].rgb;
     if all(d == vec3<f32>(0.0)) && covered == 0u {
-        out_hdr[k] = photo_hdr[k];
+        out_hdr[k] = clipped(photo_hdr[k]);
         out[k] = photo_ldr[k];
         return;
     }
     if params.mode == 0u {
         let l = mix(max(photo_hdr[k].rgb - d, vec3<f32>(0.0)), object, alpha);
-        out_hdr[k] = vec4<f32>(l, 1.0);
+        out_hdr[k] = clipped(vec4<f32>(l, 1.0));
         out[k] = pack(codes(l));
     } else {
-        out_hdr[k] = photo_hdr[k];
+        out_hdr[k] = clipped(photo_hdr[k]);
         out[k] = pack(mix(clamp(unpack(photo_ldr[k]) - d, vec3<f32>(0.0), vec3<f32>(255.0)), codes(object), alpha));
     }
 }

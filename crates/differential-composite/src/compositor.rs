@@ -81,6 +81,10 @@ pub struct Compositor {
     /// 1 - L_object / L_sources per channel, L_object the object's radiance facing away from
     /// the representative's direction. `false`: the paper's, the source's light removed whole.
     pub object_replaces_sources: bool,
+    /// The radiance the photograph saturates at, if it clips: the HDR composite is clipped
+    /// there as the camera would have (its clipped pixels in `photo_hdr` may be raised above
+    /// it, so that a shadow cast on them darkens from their estimated radiance).
+    pub clip: Option<f32>,
     bvh: Box<dyn Visibility>,
 }
 
@@ -233,6 +237,7 @@ impl Compositor {
             probe,
             object_lights: Vec::new(),
             object_replaces_sources: false,
+            clip: None,
             bvh,
         })
     }

@@ -564,7 +564,7 @@ impl GpuCompositor {
             samples: gb.position.width() / w.max(1),
             light_count: lights.len() as u32 / 2,
             pad: [0; 2],
-            response: [c.response.exposure, 1.0 / c.response.gamma, c.response.white, 0.0],
+            response: [c.response.exposure, 1.0 / c.response.gamma, c.response.white, c.clip.unwrap_or(0.0)],
             albedo: (object.albedo / std::f32::consts::PI).extend(0.0).to_array(),
             irradiance,
             lights: std::array::from_fn(|k| lights.get(k).copied().unwrap_or([0.0; 4])),

@@ -22,12 +22,9 @@ pub(crate) fn run(args: &CompositeArgs) -> Result<(), String> {
         }
     };
     let e = |e: differential_composite::CompositeError| e.to_string();
-    let map_path = args.envmap.as_deref().ok_or("--envmap: the map to composite onto")?;
-    let at = trade::args::parse_vec3(args.at.as_deref().unwrap_or("0,0,3")).map_err(|e| format!("--at {e}"))?;
     if !(args.fov > 0.0 && args.fov < 180.0) {
         return Err(format!("--fov {}: degrees in (0, 180)", args.fov));
     }
-    let backdrop = Backdrop::new(args.camera_height, args.ground_radius).map_err(|e| e.to_string())?;
     let gpu_settings = differential_composite::gpu::GpuSettings {
         pcss: (!args.hard_shadows).then_some(shadowmap_paraboloid::Pcss {
             blocker_samples: args.pcss_samples.div_ceil(2).max(1),
@@ -38,17 +35,35 @@ pub(crate) fn run(args: &CompositeArgs) -> Result<(), String> {
         cull_masks: true,
         ..args.gpu_settings()?
     };
-    // the inputs first: a bad map, model or camera is refused before the GPU and the renders
-    let map = trade::args::load_map(Some(map_path)).map_err(|e| e.to_string())?;
-    let placement = ObjectPlacement { at, scale: args.scale, rotate_y_degrees: args.rotate_y, size: args.object_size };
+    // the inputs first: a bad map, photograph, model or camera is refused before the GPU and
+    // the renders
+    let view = View::new(args)?;
+    let map_path = view.map_path.clone();
+    let map = trade::args::load_map(Some(&map_path)).map_err(|e| e.to_string())?;
+    if view.photo.is_some() && !(1.9..=2.1).contains(&(map.width() as f32 / map.height() as f32)) {
+        return Err(format!(
+            "{}: {} x {} is not a light probe (an equirectangular map, 2:1)",
+            map_path.display(),
+            map.width(),
+            map.height()
+        ));
+    }
+    let at = view.at;
+    let placement = ObjectPlacement {
+        at: at - view.shift,
+        scale: args.scale,
+        rotate_y_degrees: args.rotate_y,
+        size: args.object_size,
+    };
     let (object, warnings) = SyntheticObject::open_placed(&args.object, &placement).map_err(e)?;
     for w in warnings {
         eprintln!("warning: {}: {w}", args.object);
     }
-    let (w, h) = args.size;
-    let (eye, target) = match (args.eye, args.target) {
-        (Some(eye), Some(target)) => (eye, target),
-        _ => (backdrop.probe(), object.centre),
+    let (w, h) = view.size;
+    let backdrop = view.backdrop;
+    let (eye, target) = match view.eye_target {
+        Some((eye, target)) => (eye - view.shift, target - view.shift),
+        None => (backdrop.probe(), object.centre),
     };
     let camera = scene::Camera { eye, target, up: Vec3::Y, hfov_degrees: args.fov, width: w, height: h };
     Backdrop::check_camera(&camera).map_err(|e| format!("--eye/--target: {e}"))?;
@@ -66,8 +81,20 @@ pub(crate) fn run(args: &CompositeArgs) -> Result<(), String> {
         ..BackdropSettings::default()
     };
     let t = std::time::Instant::now();
-    let session = BackdropSession::new(map, camera, &settings).map_err(e)?;
+    let session = match &view.photo {
+        Some(photo) => BackdropSession::with_photo(map, photo, camera, &settings)
+            .map_err(|e| format!("{}: {e}", args.photo.as_deref().unwrap_or(Path::new("")).display()))?,
+        None => BackdropSession::new(map, camera, &settings).map_err(e)?,
+    };
     let c = &session.compositor;
+    if let (Some((g, scale)), Some(photo)) = (&session.photo, &view.photo) {
+        say(&format!(
+            "{}: {w} x {h}, exposure x {scale:.4} to the probe's units; {} pixels clipped, {} raised to the probe's radiance",
+            args.photo.as_deref().unwrap_or(Path::new("")).display(),
+            photo.clipped_pixels(),
+            g.raised
+        ));
+    }
     say(&format!(
         "{}: {w} x {h}, {} ground patches ({} seen), {} sources ({} lights, {} cones of the rest of the sky) ({:.1} s)",
         map_path.display(),
@@ -134,8 +161,12 @@ pub(crate) fn run(args: &CompositeArgs) -> Result<(), String> {
             "envmap": map_path.display().to_string(),
             "object": args.object,
             "at": at.to_array(),
-            "eye": eye.to_array(),
-            "target": target.to_array(),
+            "eye": (eye + view.shift).to_array(),
+            "target": (target + view.shift).to_array(),
+            "photo": args.photo.as_ref().map(|p| p.display().to_string()),
+            "photo_exposure": session.photo.as_ref().map(|p| p.1),
+            "clipped_pixels": view.photo.as_ref().map(real_scene::Photograph::clipped_pixels),
+            "clipped_raised": session.photo.as_ref().map(|p| p.0.raised),
             "passes": main.passes,
             "representatives": main.reps,
             "mode": main.mode_label().to_lowercase(),
@@ -198,6 +229,85 @@ pub(crate) fn run(args: &CompositeArgs) -> Result<(), String> {
     }
     outln!("wrote {} (and _plate, _truth, _catcher, _error; EXR beside)", args.out.display());
     Ok(())
+}
+
+/// What the command's options say of the view: the map (or probe) and, with a photograph, the
+/// photograph at the image's size and the shift that puts the probe's foot at the origin and
+/// the ground at y = 0 (the backdrop's frame; the user's coordinates are reported).
+struct View {
+    map_path: PathBuf,
+    photo: Option<real_scene::Photograph>,
+    backdrop: Backdrop,
+    shift: Vec3,
+    at: Vec3,
+    eye_target: Option<(Vec3, Vec3)>,
+    size: (u32, u32),
+}
+
+impl View {
+    fn new(args: &CompositeArgs) -> Result<Self, String> {
+        let eye_target = args.eye.zip(args.target);
+        let Some(photo_path) = &args.photo else {
+            let map_path = args.envmap.clone().ok_or("--envmap: the map to composite onto")?;
+            let at = trade::args::parse_vec3(args.at.as_deref().unwrap_or("0,0,3")).map_err(|e| format!("--at {e}"))?;
+            let backdrop = Backdrop::new(args.camera_height, args.ground_radius).map_err(|e| e.to_string())?;
+            return Ok(Self { map_path, photo: None, backdrop, shift: Vec3::ZERO, at, eye_target, size: args.size() });
+        };
+        if args.envmap.is_some() || args.scene.is_some() {
+            return Err("--photo takes its light probe as --probe, without --envmap or --scene".into());
+        }
+        let map_path = args.probe.clone().ok_or("--photo needs --probe: the light probe taken where it was")?;
+        let (eye, target) = eye_target.ok_or("--photo needs --eye and --target: the camera that took it")?;
+        if !args.ground_y.is_finite() {
+            return Err(format!("--ground-y {}: not a height", args.ground_y));
+        }
+        if eye.y <= args.ground_y {
+            return Err(format!(
+                "--eye {},{},{}: the camera is not above the ground (y = {})",
+                eye.x, eye.y, eye.z, args.ground_y
+            ));
+        }
+        let probe_at = args.probe_at.unwrap_or(eye);
+        if probe_at.y <= args.ground_y {
+            return Err(format!(
+                "--probe-at {},{},{}: the probe is not above the ground (y = {})",
+                probe_at.x, probe_at.y, probe_at.z, args.ground_y
+            ));
+        }
+        let backdrop =
+            Backdrop::new(probe_at.y - args.ground_y, args.ground_radius).map_err(|e| format!("--probe-at: {e}"))?;
+        let photo = real_scene::Photograph::open(photo_path, args.gamma).map_err(|e| e.to_string())?;
+        let (pw, ph) = (photo.width, photo.height);
+        let aspect = pw as f32 / ph as f32;
+        let size = match args.size {
+            Some((w, h)) => {
+                if ((w as f32 / h as f32) / aspect - 1.0).abs() > 0.01 {
+                    return Err(format!(
+                        "{}: its {pw} x {ph} does not match the camera's {w} x {h} (--size): another aspect",
+                        photo_path.display()
+                    ));
+                }
+                (w, h)
+            }
+            None if pw > 320 => (320, ((320.0 / aspect).round() as u32).max(1)),
+            None => (pw, ph),
+        };
+        let shift = Vec3::new(probe_at.x, args.ground_y, probe_at.z);
+        // by default on the ground under the point looked at
+        let at = match &args.at {
+            Some(at) => trade::args::parse_vec3(at).map_err(|e| format!("--at {e}"))?,
+            None => Vec3::new(target.x, args.ground_y, target.z),
+        };
+        Ok(Self {
+            map_path,
+            photo: Some(photo.resized(size.0, size.1)),
+            backdrop,
+            shift,
+            at,
+            eye_target: Some((eye, target)),
+            size,
+        })
+    }
 }
 
 /// `frames` positions along a line across the ground: per frame the traversal and the GPU

@@ -26,6 +26,25 @@ pub struct CompositeArgs {
     /// lower hemisphere projected onto a ground disc (the backdrop).
     #[arg(long)]
     pub envmap: Option<PathBuf>,
+    /// A user's photograph (PNG or JPEG through a response of --gamma, or an HDR EXR) to
+    /// composite into, with --probe, --eye, --target and --fov: the ground plane is at
+    /// --ground-y.
+    #[arg(long, requires_all = ["probe", "eye", "target"])]
+    pub photo: Option<PathBuf>,
+    /// The light probe taken where the photograph was (an HDR lat-long map, .exr or .hdr).
+    #[arg(long, requires = "photo")]
+    pub probe: Option<PathBuf>,
+    /// Photograph: the ground plane's height.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub ground_y: f32,
+    /// Photograph: where the probe was captured (its ground projection's centre); by default
+    /// where the camera stood.
+    #[arg(long, value_parser = trade::args::parse_vec3, requires = "photo", allow_hyphen_values = true)]
+    pub probe_at: Option<Vec3>,
+    /// Photograph: the gamma of the camera's response (8-bit and 16-bit images are read
+    /// through its inverse; the composite is written through it).
+    #[arg(long, default_value_t = 2.2)]
+    pub gamma: f32,
     /// The object: a built-in (sphere, box) or a glTF model's path (.gltf, .glb). In a built-in
     /// scene a model is fitted into a cube of --object-size; on a backdrop it keeps its own
     /// size (glTF's metres) unless --object-size is given.
@@ -101,9 +120,10 @@ pub struct CompositeArgs {
     /// scene).
     #[arg(long)]
     pub sweep: bool,
-    /// Image size WIDTHxHEIGHT.
-    #[arg(long, value_parser = parse_size, default_value = "320x240")]
-    pub size: (u32, u32),
+    /// Image size WIDTHxHEIGHT (default 320x240; with --photo the photograph's aspect, 320
+    /// wide at most).
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
     /// Built-in scene: samples per pixel of the photograph, the truth and Debevec's renders.
     #[arg(long, default_value_t = 32)]
     pub spp: u32,
@@ -133,6 +153,11 @@ pub struct CompositeArgs {
 }
 
 impl CompositeArgs {
+    /// The image size asked for, or the default.
+    pub(crate) fn size(&self) -> (u32, u32) {
+        self.size.unwrap_or((320, 240))
+    }
+
     /// The frames of `--path`, if asked for.
     pub(crate) fn path_frames(&self) -> Option<usize> {
         self.path.map(|n| n.unwrap_or(self.frames).max(1))
@@ -158,7 +183,7 @@ impl CompositeArgs {
 }
 
 pub(crate) fn run(args: &CompositeArgs) -> Result<(), String> {
-    if args.scene.is_none() && args.envmap.is_some() {
+    if args.photo.is_some() || (args.scene.is_none() && args.envmap.is_some()) {
         return crate::backdrop::run(args);
     }
     let say = |s: &str| {
@@ -183,7 +208,7 @@ pub(crate) fn run(args: &CompositeArgs) -> Result<(), String> {
     let (map, lights) =
         trade::session::environment(&probe, light_extract::DEFAULT_METHOD, 32).map_err(|e| e.to_string())?;
     let settings = SessionSettings {
-        size: Some(args.size),
+        size: Some(args.size()),
         photo: PhotoSettings { spp: args.spp, ..SessionSettings::default().photo },
         reconstruction: Perturbation { reflectance_scale: args.reflectance_scale, ..Perturbation::NONE },
         estimate_reflectances: args.estimate_reflectances,
@@ -201,8 +226,8 @@ pub(crate) fn run(args: &CompositeArgs) -> Result<(), String> {
     say(&format!(
         "{}: {} x {}, photograph {} spp, {} sources, {} receivers; reconstruction with reflectances x {}{}, pruning {} ({:.1} s)",
         scene_name,
-        args.size.0,
-        args.size.1,
+        args.size().0,
+        args.size().1,
         args.spp,
         c.prepared.sources.len(),
         c.prepared.receivers.len(),
@@ -224,7 +249,7 @@ pub(crate) fn run(args: &CompositeArgs) -> Result<(), String> {
     let passes: Vec<usize> = if args.sweep { vec![1, 10, 20, 50, 0] } else { vec![args.passes] };
     let modes: Vec<Mode> = if args.sweep { vec![Mode::Hdr, Mode::Ldr] } else { vec![mode] };
     let table = rows(&gpu, &gc, c, &object, &truth, &passes, &modes, &gpu_settings, 5).map_err(|e| e.to_string())?;
-    let (w, h) = args.size;
+    let (w, h) = args.size();
     let save = |path: &Path, img: &[[u8; 3]]| save_png(path, (w, h), img);
     let beside = |suffix: &str| -> PathBuf {
         let stem = args.out.file_stem().map_or_else(|| "composite".into(), |s| s.to_string_lossy().to_string());

@@ -519,4 +519,77 @@ fn composite_onto_a_map_has_the_interface_keys_and_refuses_bad_input() {
         let lines: Vec<&str> = err.lines().filter(|l| !l.contains("XDG_RUNTIME_DIR")).collect();
         assert!(lines.len() == 1 && lines[0].contains(want), "{bad:?}: {err}");
     }
+    // the plate as the user's photograph, the map as its probe, the same camera: the same
+    // composite, near enough
+    let plate = dir.join("b_plate.png");
+    let target: Vec<String> = v["target"]
+        .as_array()
+        .map(|a| a.iter().filter_map(serde_json::Value::as_f64).map(|x| x.to_string()).collect())
+        .unwrap_or_default();
+    let target = target.join(",");
+    let photo_out = dir.join("p.png");
+    let photo_args = ["--photo", plate.to_str().unwrap_or_default(), "--probe", map, "--eye", "0,1.6,0"];
+    let run = envshadow(
+        &[
+            &["composite"][..],
+            &photo_args,
+            &["--target", &target, "--object", cube, "--at", "0.2,0,3"],
+            &small,
+            &["--out", photo_out.to_str().unwrap_or_default(), "--json"],
+        ]
+        .concat(),
+    );
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let p: serde_json::Value = serde_json::from_str(&String::from_utf8_lossy(&run.stdout)).expect("valid JSON");
+    for k in ["ms_per_frame", "error_rmse_codes", "pathtraced_error_rmse_codes", "pathtraced_ms", "changed_pixels"] {
+        assert!(p.get(k).is_some_and(serde_json::Value::is_number), "missing number {k} in {p}");
+    }
+    assert!(p["photo_exposure"].as_f64().is_some_and(|x| x > 0.0) && p["clipped_pixels"].is_u64(), "{p}");
+    let (ours, backdrop) =
+        (p["error_rmse_codes"].as_f64().unwrap_or(f64::NAN), v["error_rmse_codes"].as_f64().unwrap_or(0.0));
+    assert!(ours < 1.5 * backdrop + 1.0, "photograph {ours} codes against the backdrop's {backdrop}");
+    assert!(dir.join("p_truth.png").is_file() && dir.join("p_error.png").is_file());
+    // a probe that is not a map (a PNG; a 4:3 EXR), a photograph of another aspect, a camera
+    // under the ground, a missing photograph: one line, exit 1
+    let not_probe = dir.join("b_truth.exr");
+    let missing_photo = dir.join("missing.png");
+    let photo = plate.to_str().unwrap_or_default();
+    let cases: [(&[&str], &str); 5] = [
+        (&["--photo", photo, "--probe", photo, "--eye", "0,1.6,0", "--target", "0,0,3"], "b_plate.png"),
+        (
+            &[
+                "--photo",
+                photo,
+                "--probe",
+                not_probe.to_str().unwrap_or_default(),
+                "--eye",
+                "0,1.6,0",
+                "--target",
+                "0,0,3",
+            ],
+            "not a light probe",
+        ),
+        (&["--photo", photo, "--probe", map, "--eye", "0,1.6,0", "--target", "0,0,3", "--size", "48x48"], "aspect"),
+        (&["--photo", photo, "--probe", map, "--eye", "0,-1,0", "--target", "0,0,3"], "not above the ground"),
+        (
+            &[
+                "--photo",
+                missing_photo.to_str().unwrap_or_default(),
+                "--probe",
+                map,
+                "--eye",
+                "0,1.6,0",
+                "--target",
+                "0,0,3",
+            ],
+            "missing.png",
+        ),
+    ];
+    for (bad, want) in cases {
+        let run = envshadow(&[&["composite"][..], bad, &["--truth-spp", "2", "--catcher-spp", "1"]].concat());
+        assert_eq!(run.status.code(), Some(1), "{bad:?}");
+        let err = String::from_utf8_lossy(&run.stderr);
+        let lines: Vec<&str> = err.lines().filter(|l| !l.contains("XDG_RUNTIME_DIR")).collect();
+        assert!(lines.len() == 1 && lines[0].contains(want), "{bad:?}: {err}");
+    }
 }

@@ -176,7 +176,18 @@ impl Backdrop {
     /// [`Backdrop::ground_irradiance`]; `camera` is the view composited.
     #[must_use]
     pub fn real_scene(&self, map: &EnvMap, camera: &scene::Camera) -> RealScene {
-        let e = Self::ground_irradiance(map);
+        self.real_scene_from(&|p| self.ground_radiance(map, p), Self::ground_irradiance(map), camera)
+    }
+
+    /// [`Backdrop::real_scene`] with the ground's radiance at each point from `radiance` (a
+    /// photograph's, [`crate::PhotoGround`]) under irradiance `e`.
+    #[must_use]
+    pub fn real_scene_from(
+        &self,
+        radiance: &(dyn Fn(Vec3) -> Vec3 + Sync),
+        e: Vec3,
+        camera: &scene::Camera,
+    ) -> RealScene {
         let s = self.segments.max(3);
         let at = |r: f32, k: u32| {
             let (sin, cos) = (std::f32::consts::TAU * k as f32 / s as f32).sin_cos();
@@ -207,7 +218,7 @@ impl Backdrop {
                 for j in 0..n {
                     for i in 0..n {
                         let q = p.point((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
-                        sum += self.ground_radiance(map, q);
+                        sum += radiance(q);
                     }
                 }
                 p.radiance = sum / (n * n) as f32;
@@ -224,7 +235,18 @@ impl Backdrop {
     /// that the ground lit by the map without the object shows the backplate.
     #[must_use]
     pub fn ground(&self, map: &EnvMap, texels: u32) -> (scene::Object, scene::Texture) {
-        let e = Self::ground_irradiance(map);
+        self.ground_from(&|p| self.ground_radiance(map, p), Self::ground_irradiance(map), texels)
+    }
+
+    /// [`Backdrop::ground`] with the ground's radiance at each point from `radiance` under
+    /// irradiance `e`.
+    #[must_use]
+    pub fn ground_from(
+        &self,
+        radiance: &(dyn Fn(Vec3) -> Vec3 + Sync),
+        e: Vec3,
+        texels: u32,
+    ) -> (scene::Object, scene::Texture) {
         let r = self.ground_radius;
         let t = texels.clamp(1, 8192);
         let texel_point = |k: usize| {
@@ -234,7 +256,7 @@ impl Backdrop {
         let texels_rgba: Vec<[u8; 4]> = (0..(t * t) as usize)
             .into_par_iter()
             .map(|k| {
-                let rho = Self::reflectance(self.ground_radiance(map, texel_point(k)), e);
+                let rho = Self::reflectance(radiance(texel_point(k)), e);
                 let c = rho.to_array().map(scene::texture::linear_to_srgb8);
                 [c[0], c[1], c[2], 255]
             })
@@ -271,6 +293,88 @@ impl Backdrop {
             material: scene::Material { maps: Some(maps), ..scene::Material::lambert(1.0) },
         };
         (object, texture)
+    }
+}
+
+/// A user's photograph as the backplate of a backdrop: the ground the camera sees in it takes
+/// the photograph's radiance, the ground it does not see the probe's projection
+/// ([`Backdrop::ground_radiance`], the probe at the backdrop's centre of projection). Where the
+/// photograph clipped, a ground pixel's channel is the probe's projection of the same point
+/// where that is brighter (the clip is a lower bound; the probe, an HDR capture of the same
+/// place, saw past it).
+#[derive(Clone, Debug)]
+pub struct PhotoGround {
+    /// The ground projection (the probe's height, the disc).
+    pub backdrop: Backdrop,
+    /// The camera that took the photograph (its size the photograph's).
+    pub camera: scene::Camera,
+    /// The photograph in the probe's units, clipped channels raised as above (row-major).
+    pub plate: Vec<Vec3>,
+    /// The radiance a channel of the photograph saturates at (the probe's units), if it clips.
+    pub clip: Option<f32>,
+    /// Pixels whose clipped channels the probe raised.
+    pub raised: usize,
+    /// The gamma of the response the photograph was read through.
+    pub gamma: f32,
+}
+
+impl PhotoGround {
+    /// The ground of `photo` (already in `probe`'s units and at `camera`'s size) seen by
+    /// `camera`, above `backdrop`'s ground.
+    ///
+    /// # Errors
+    /// [`RealSceneError::Parameter`] when the photograph's size is not the camera's.
+    pub fn new(
+        backdrop: Backdrop,
+        probe: &EnvMap,
+        photo: &crate::Photograph,
+        camera: scene::Camera,
+    ) -> Result<Self, RealSceneError> {
+        if (photo.width, photo.height) != (camera.width, camera.height) {
+            return Err(RealSceneError::Parameter(format!(
+                "a photograph of {} x {} for a camera of {} x {}",
+                photo.width, photo.height, camera.width, camera.height
+            )));
+        }
+        let rays = camera.rays();
+        let w = camera.width as usize;
+        let (plate, raised): (Vec<Vec3>, Vec<bool>) =
+            (0..photo.radiance.len())
+                .into_par_iter()
+                .map(|k| {
+                    let (l, mask) = (photo.radiance[k], photo.clipped[k]);
+                    if mask == 0 {
+                        return (l, false);
+                    }
+                    let (o, d) = rays.ray((k % w) as f32 + 0.5, (k / w) as f32 + 0.5);
+                    let Some(p) = backdrop.ground_hit(o, d) else { return (l, false) };
+                    let seen = backdrop.ground_radiance(probe, p);
+                    let up = Vec3::from_array(std::array::from_fn(|c| {
+                        if mask & (1 << c) != 0 { l[c].max(seen[c]) } else { l[c] }
+                    }));
+                    (up, up != l)
+                })
+                .unzip();
+        let raised = raised.iter().filter(|&&r| r).count();
+        Ok(Self { backdrop, camera, plate, clip: photo.clip, raised, gamma: photo.gamma })
+    }
+
+    /// The radiance of ground point `p`: the plate's (bilinear) where the camera sees it, the
+    /// probe's projection elsewhere.
+    #[must_use]
+    pub fn radiance(&self, probe: &EnvMap, p: Vec3) -> Vec3 {
+        let (w, h) = (self.camera.width as f32, self.camera.height as f32);
+        match self.camera.project(p) {
+            Some(xy) if xy.x >= 0.0 && xy.y >= 0.0 && xy.x < w && xy.y < h => {
+                let (x, y) = ((xy.x - 0.5).clamp(0.0, w - 1.0), (xy.y - 0.5).clamp(0.0, h - 1.0));
+                let (x0, y0) = (x.floor() as usize, y.floor() as usize);
+                let (x1, y1) = ((x0 + 1).min(w as usize - 1), (y0 + 1).min(h as usize - 1));
+                let (fx, fy) = (x - x0 as f32, y - y0 as f32);
+                let at = |i: usize, j: usize| self.plate[j * w as usize + i];
+                at(x0, y0).lerp(at(x1, y0), fx).lerp(at(x0, y1).lerp(at(x1, y1), fx), fy)
+            }
+            _ => self.backdrop.ground_radiance(probe, p),
+        }
     }
 }
 

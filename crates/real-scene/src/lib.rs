@@ -15,9 +15,9 @@ pub mod formfactor;
 mod photo;
 mod radiosity;
 
-pub use backdrop::Backdrop;
+pub use backdrop::{Backdrop, PhotoGround};
 pub use builtin::{BUILTIN_REAL_SCENES, Perturbation};
-pub use photo::CameraResponse;
+pub use photo::{CameraResponse, MAX_PHOTO_PIXELS, MAX_PHOTO_SIDE, Photograph};
 pub use radiosity::{SolveReport, SolveSettings, estimate_reflectances, solve};
 pub use scene::Visibility;
 
@@ -165,4 +165,12 @@ pub enum RealSceneError {
     /// A parameter out of its range (a backdrop's height or radius, a camera below the ground).
     #[error("{0}")]
     Parameter(String),
+    /// A photograph that cannot be read or used, and why.
+    #[error("{path}: {reason}", path = path.display())]
+    Photo {
+        /// The file.
+        path: std::path::PathBuf,
+        /// Why.
+        reason: String,
+    },
 }

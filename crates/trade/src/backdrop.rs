@@ -10,7 +10,7 @@ use differential_composite::{CompositeError, Compositor, SyntheticObject};
 use envmap_sphere::EnvMap;
 use glam::Vec3;
 use light_extract::LightExtractor;
-use real_scene::{Backdrop, CameraResponse, luminance};
+use real_scene::{Backdrop, CameraResponse, PhotoGround, Photograph, luminance};
 use ref_tracer::SceneBvh;
 use scene::DistantLight;
 use shaft_hierarchy::preprocess::{PreprocessSettings, build};
@@ -75,6 +75,16 @@ impl Default for BackdropSettings {
     }
 }
 
+/// Refuses an image size of 0 or over 8192 a side, and a camera below the ground or not a view.
+fn check_view(camera: &scene::Camera) -> Result<(), CompositeError> {
+    let (w, h) = (camera.width, camera.height);
+    if w == 0 || h == 0 || w > 8192 || h > 8192 {
+        return Err(CompositeError::Parameter(format!("image size {w} x {h} (1 to 8192 a side)")));
+    }
+    Backdrop::check_camera(camera)?;
+    Ok(())
+}
+
 /// A map's shadow sources above the ground: its extracted lights, then the rest of its upper
 /// hemisphere split by median cut into `residual` cones (those with any power). Returns the
 /// sources, how many of them are the extracted lights, and the extraction's compact EnvDirects
@@ -115,7 +125,7 @@ pub fn sources(
 
 /// A backdrop compositing session: the map, the view, the compositor and the truth's ground.
 pub struct BackdropSession {
-    /// The map.
+    /// The map (in photograph mode the light probe).
     pub map: EnvMap,
     /// The ground projection.
     pub backdrop: Backdrop,
@@ -125,42 +135,101 @@ pub struct BackdropSession {
     pub ground: (scene::Object, scene::Texture),
     /// Extracted lights and residual cones among the sources.
     pub lights: (usize, usize),
+    /// In photograph mode: the photograph's ground, and the scale that brought the photograph
+    /// to the probe's units.
+    pub photo: Option<(PhotoGround, f32)>,
 }
 
 impl BackdropSession {
-    /// The session for `map` seen by `camera`.
+    /// The session for `map` seen by `camera`: the backplate is the map, its lower hemisphere
+    /// projected onto the ground.
     ///
     /// # Errors
     /// A camera below the ground or not a view, a size of 0 or over 8192, an extraction or a
     /// hierarchy that fails.
     pub fn new(map: EnvMap, camera: scene::Camera, settings: &BackdropSettings) -> Result<Self, CompositeError> {
+        Self::build(map, camera, settings, None)
+    }
+
+    /// The session for a user's `photo` taken by `camera` (its size the photograph's) where
+    /// `probe` was captured (the backdrop's centre of projection: `settings.backdrop`'s
+    /// height above the ground under the origin). The photograph is brought to the probe's
+    /// units by [`Photograph::exposure_against`] what the probe sees along each pixel's ray;
+    /// its ground pixels are the receivers ([`PhotoGround`]).
+    ///
+    /// # Errors
+    /// As [`BackdropSession::new`]; a photograph of another size than the camera's, or one
+    /// with too few pixels to match its exposure (black, or clipped throughout).
+    pub fn with_photo(
+        probe: EnvMap,
+        photo: &Photograph,
+        camera: scene::Camera,
+        settings: &BackdropSettings,
+    ) -> Result<Self, CompositeError> {
+        check_view(&camera)?;
+        let backdrop = settings.backdrop;
+        let seen = backdrop.plate(&probe, &camera, 1);
+        let scale = photo.exposure_against(&seen).ok_or_else(|| {
+            CompositeError::Parameter(
+                "the photograph's exposure cannot be matched to the probe's: fewer than 16 pixels lit and unclipped"
+                    .into(),
+            )
+        })?;
+        let ground = PhotoGround::new(backdrop, &probe, &photo.clone().scaled(scale), camera)?;
+        Self::build(probe, camera, settings, Some((ground, scale)))
+    }
+
+    fn build(
+        map: EnvMap,
+        camera: scene::Camera,
+        settings: &BackdropSettings,
+        photo: Option<(PhotoGround, f32)>,
+    ) -> Result<Self, CompositeError> {
+        check_view(&camera)?;
         let (w, h) = (camera.width, camera.height);
-        if w == 0 || h == 0 || w > 8192 || h > 8192 {
-            return Err(CompositeError::Parameter(format!("image size {w} x {h} (1 to 8192 a side)")));
-        }
-        Backdrop::check_camera(&camera)?;
         let backdrop = settings.backdrop;
         let (lights, main, mut direct) = sources(&map, settings.lights, settings.residual_lights)?;
-        let model = backdrop.real_scene(&map, &camera);
-        let plate = backdrop.plate(&map, &camera, settings.plate_samples);
-        let response = CameraResponse::auto(&plate);
+        let e = Backdrop::ground_irradiance(&map);
+        let radiance = |p: Vec3| match &photo {
+            Some((g, _)) => g.radiance(&map, p),
+            None => backdrop.ground_radiance(&map, p),
+        };
+        let model = backdrop.real_scene_from(&radiance, e, &camera);
+        let (plate, response, clip) = match &photo {
+            Some((g, _)) => {
+                let gamma = g.gamma;
+                let response = match g.clip {
+                    // the photograph's own clip is the response's white
+                    Some(c) if c > 0.0 => CameraResponse { exposure: 1.0 / c, gamma, white: 1.0 },
+                    _ => CameraResponse { gamma, ..CameraResponse::auto(&g.plate) },
+                };
+                (g.plate.clone(), response, g.clip)
+            }
+            None => {
+                let plate = backdrop.plate(&map, &camera, settings.plate_samples);
+                let response = CameraResponse::auto(&plate);
+                (plate, response, None)
+            }
+        };
         let bvh = SceneBvh::new(&model.to_scene());
         let built = build(&model, &lights, &bvh, &settings.preprocess)?;
         // the compositor's own ray queries: the BVH the pre-process used
         let rays = Box::new(bvh);
-        // each receiver pixel's own reflectance, from the ground point its centre ray meets
-        let e = Backdrop::ground_irradiance(&map);
+        // each receiver pixel's own reflectance: the ground point its centre ray meets (the
+        // photograph's pixel itself in photograph mode)
         let camera_rays = camera.rays();
         let per_pixel: Vec<Vec3> = (0..w * h)
             .map(|k| {
                 let (o, d) = camera_rays.ray((k % w) as f32 + 0.5, (k / w) as f32 + 0.5);
-                backdrop
-                    .ground_hit(o, d)
-                    .map_or(Vec3::ZERO, |p| Backdrop::reflectance(backdrop.ground_radiance(&map, p), e))
+                backdrop.ground_hit(o, d).map_or(Vec3::ZERO, |p| match &photo {
+                    Some((g, _)) => Backdrop::reflectance(g.plate[k as usize], e),
+                    None => Backdrop::reflectance(backdrop.ground_radiance(&map, p), e),
+                })
             })
             .collect();
         let mut compositor = Compositor::new(model, lights, Some(map.clone()), built, plate, response, rays)?
             .with_pixel_reflectance(&per_pixel)?;
+        compositor.clip = clip;
         // the object: its suns per pixel (SH9 rings around a sun), the rest of the map by SH9
         direct.sort_by(|a, b| luminance(b.power()).total_cmp(&luminance(a.power())));
         direct.truncate(differential_composite::gpu::MAX_OBJECT_LIGHTS);
@@ -174,8 +243,8 @@ impl BackdropSession {
         compositor.object_lights = direct;
         compositor.object_replaces_sources = true;
         let residual = compositor.lights.len() - main;
-        let ground = backdrop.ground(&map, settings.ground_texels);
-        Ok(Self { map, backdrop, compositor, ground, lights: (main, residual) })
+        let ground = backdrop.ground_from(&radiance, e, settings.ground_texels);
+        Ok(Self { map, backdrop, compositor, ground, lights: (main, residual), photo })
     }
 
     /// The local scene path traced with `object` and without it, `spp` samples a pixel each
@@ -207,6 +276,11 @@ impl BackdropSession {
                 } else {
                     (c.photo_hdr[k] + with.color[k] - without.color[k]).max(Vec3::ZERO)
                 }
+            })
+            // the camera's clip, where the photograph has one
+            .map(|l: Vec3| match c.clip {
+                Some(clip) => l.min(Vec3::splat(clip)),
+                None => l,
             })
             .collect();
         (image, t.elapsed())

@@ -23,6 +23,11 @@ fn gpu() -> &'static gpu::Gpu {
 /// A sky of radiance 0.6 (bluer at the zenith) over a ground of 0.1-0.2 with a pattern, and a
 /// sun of `sun` = (direction, radiance) 1.5 degrees in radius.
 fn map(sun: Option<(Vec3, f32)>) -> EnvMap {
+    striped_map(sun, 0.05)
+}
+
+/// [`map`] with the ground's pattern `stripe` brighter in red and blue.
+fn striped_map(sun: Option<(Vec3, f32)>, stripe: f32) -> EnvMap {
     let (w, h) = (512u32, 256u32);
     let probe = EnvMap::from_texels(w, h, |_, _| Vec3::ZERO);
     EnvMap::from_texels(w, h, |i, j| {
@@ -35,7 +40,7 @@ fn map(sun: Option<(Vec3, f32)>) -> EnvMap {
         if d.y >= 0.0 {
             Vec3::new(0.5, 0.55, 0.6 + 0.2 * d.y)
         } else {
-            let stripe = if (i / 16 + j / 16) % 2 == 0 { 0.05 } else { 0.0 };
+            let stripe = if (i / 16 + j / 16) % 2 == 0 { stripe } else { 0.0 };
             Vec3::new(0.15 + stripe, 0.13, 0.1 + stripe)
         }
     })
@@ -252,4 +257,95 @@ fn culled_masks_draw_the_same_image() {
             assert!(a.0 == b.0 && a.1 == b.1, "{sun:?}: the culled masks changed the image");
         }
     }
+}
+
+/// A sun behind the camera and to its left, 30 degrees up: the sphere's shadow falls ahead,
+/// in view.
+fn sun_behind() -> Option<(Vec3, f32)> {
+    Some((Vec3::new(-0.4, 0.6, -1.0).normalize(), 3e3))
+}
+
+#[test]
+fn a_photograph_of_the_backdrop_composites_as_the_backdrop() {
+    // the backdrop's own plate as the user's photograph (at a quarter of the probe's exposure),
+    // the map as its probe, the camera where the probe was: the same composite
+    let at = Vec3::new(0.0, 0.0, 2.5);
+    let object = sphere(at, 1.0);
+    let cam = camera(Vec3::new(0.0, 1.6, 0.0), at + Vec3::Y * 0.3);
+    let s = BackdropSession::new(map(sun_behind()), cam, &settings(20.0)).unwrap();
+    let photo = real_scene::Photograph::from_hdr(SIZE.0, SIZE.1, s.compositor.photo_hdr.clone()).scaled(0.25);
+    assert_eq!(photo.clip, None, "a rendered plate does not clip");
+    let p = BackdropSession::with_photo(map(sun_behind()), &photo, cam, &settings(20.0)).unwrap();
+    let scale = p.photo.as_ref().unwrap().1;
+    assert!((scale - 4.0).abs() < 4e-3, "exposure x {scale}, not 4");
+    let (a, b) = (composite(&s, &object, true).1, composite(&p, &object, true).1);
+    let c = &s.compositor;
+    let (codes_a, codes_b): (Vec<_>, Vec<_>) =
+        a.iter().zip(&b).map(|(x, y)| (c.response.apply(*x), c.response.apply(*y))).unzip();
+    let e = differential_composite::code_error(&codes_b, &codes_a, &c.photo_ldr);
+    assert!(e.changed > 300, "the shadow is in view: {} pixels", e.changed);
+    assert!(e.rmse_changed < 1.0, "photograph against backdrop: RMSE {} codes", e.rmse_changed);
+}
+
+#[test]
+fn an_hdr_photo_with_clipped_pixels_keeps_its_shadow() {
+    // the plate clipped at a level between the ground's sunlit stripes (radiance 0.4 in red)
+    // and the rest (0.15): where the sphere's shadow falls on a clipped stripe, the truth shows
+    // the stripe's own darkened radiance, which only the probe (unclipped) knows
+    let at = Vec3::new(0.0, 0.0, 2.5);
+    let object = sphere(at, 1.0);
+    let cam = camera(Vec3::new(0.0, 1.6, 0.0), at + Vec3::Y * 0.3);
+    let s = BackdropSession::new(striped_map(sun_behind(), 0.25), cam, &settings(20.0)).unwrap();
+    let (truth, _) = s.differential(&object, 128, 5);
+    let clip = 0.25;
+    let clipped: Vec<Vec3> = s.compositor.photo_hdr.iter().map(|v| v.min(Vec3::splat(clip))).collect();
+    let photo = real_scene::Photograph::from_hdr(SIZE.0, SIZE.1, clipped.clone());
+    assert_eq!(photo.clip, Some(clip), "the plateau is found");
+    assert!(photo.clipped_pixels() > 200, "{} pixels clipped", photo.clipped_pixels());
+    // the camera's 8 bits: white at the clip
+    let response = real_scene::CameraResponse { exposure: 1.0 / clip, gamma: 2.2, white: 1.0 };
+    let codes = |v: &[Vec3]| v.iter().map(|x| response.apply(*x)).collect::<Vec<_>>();
+    let truth_codes = codes(&truth.iter().map(|v| v.min(Vec3::splat(clip))).collect::<Vec<_>>());
+    let photo_codes = codes(&clipped);
+    // over the clipped pixels the truth darkens, off the object: the RMSE in codes
+    let bounds = object.bounds();
+    let rays = cam.rays();
+    let off_object = |k: usize| {
+        let (o, d) = rays.ray((k as u32 % SIZE.0) as f32 + 0.5, (k as u32 / SIZE.0) as f32 + 0.5);
+        s.backdrop.ground_hit(o, d).is_some() && ray_box(o, d, bounds.min, bounds.max).is_none()
+    };
+    let shadowed: Vec<usize> = (0..truth.len())
+        .filter(|&k| photo.clipped[k] != 0 && truth_codes[k] != photo_codes[k] && off_object(k))
+        .collect();
+    assert!(shadowed.len() > 30, "{} clipped pixels in the shadow", shadowed.len());
+    let rmse = |hdr: &[Vec3]| {
+        let c = codes(hdr);
+        let (c, t) = (&c, &truth_codes);
+        let sum: f64 =
+            shadowed.iter().flat_map(|&k| (0..3).map(move |i| (f64::from(c[k][i]) - f64::from(t[k][i])).powi(2))).sum();
+        (sum / (3 * shadowed.len()) as f64).sqrt()
+    };
+    let error = |session: &BackdropSession| {
+        let (_, hdr) = composite(session, &object, true);
+        assert!(hdr.iter().all(|v| v.is_finite() && v.min_element() >= 0.0), "a NaN or a negative");
+        (rmse(&hdr), hdr)
+    };
+    let p = BackdropSession::with_photo(striped_map(sun_behind(), 0.25), &photo, cam, &settings(20.0)).unwrap();
+    assert!(p.photo.as_ref().unwrap().0.raised > 100, "the probe raised the clipped ground");
+    let (ours, hdr) = error(&p);
+    // the ground only darkens: no raised pixel shows through brighter than the photograph
+    assert!(hdr.iter().all(|v| v.max_element() <= clip), "the composite clips where the camera did");
+    let ground = (0..hdr.len()).filter(|&k| off_object(k)).count();
+    let brighter = (0..hdr.len()).filter(|&k| off_object(k) && (hdr[k] - clipped[k]).max_element() > 1e-5).count();
+    assert!(ground > 1000 && brighter == 0, "{brighter} ground pixels brighter than the photograph");
+    // the same photograph read as unclipped: its clipped stripes' reflectance underestimated
+    let naive_photo = real_scene::Photograph { clip: None, clipped: vec![0; clipped.len()], ..photo.clone() };
+    let naive = error(
+        &BackdropSession::with_photo(striped_map(sun_behind(), 0.25), &naive_photo, cam, &settings(20.0)).unwrap(),
+    )
+    .0;
+    // and the unclipped photograph, for scale
+    let full = rmse(&composite(&s, &object, true).1);
+    assert!(ours < 0.7 * naive, "{ours} against {naive} read as unclipped");
+    assert!(ours < 1.3 * full + 0.5, "{ours} against {full} unclipped");
 }
