@@ -14,9 +14,11 @@ struct Params {
     // representatives in this batch, and the first one's index in the frame
     reps: u32,
     first_rep: u32,
-    pad0: u32,
-    pad1: u32,
-    pad2: u32,
+    // the pixel the dispatch starts at: the corner of the batch's rectangles' union
+    origin_x: u32,
+    origin_y: u32,
+    // the object's bounding radius: within it of the object, a receiver is at its contact
+    object_radius: f32,
 }
 
 struct PixelRef {
@@ -41,6 +43,9 @@ struct PixelRef {
 // per representative of the batch, the pixels (x0, y0, x1, y1; ends excluded) its shadow can
 // reach (`gpu::shadow_rect`; the whole image where not culled)
 @group(0) @binding(6) var<storage, read> rects: array<vec4<u32>>;
+// per representative of the frame, what a blocked receiver keeps of its transfer
+// (`RepTransfer::keep`: the object's own radiance in its sources' place)
+@group(0) @binding(7) var<storage, read> keeps: array<vec4<f32>>;
 
 // Vogel-disk sample k of n at radius 1, turned by `spin` radians.
 fn vogel(k: u32, n: u32, spin: f32) -> vec2<f32> {
@@ -64,14 +69,17 @@ fn blocked(r: u32, t: vec2<f32>, depth: f32) -> vec2<f32> {
 // Percentage-closer soft shadows of a distant representative (its map orthographic, `pcss.y`
 // the tangent of the cone holding its sources): the mean blocker depth over the cone's
 // footprint, the penumbra it implies, that much filtering; depths compared with a
-// receiver-plane bias, as `shadowmap-paraboloid`'s visibility pass does.
-fn soft_lit(r: u32, rec: MapReceiver, pixel: vec2<u32>) -> f32 {
+// receiver-plane bias, as `shadowmap-paraboloid`'s visibility pass does (a constant bias gave
+// darker contact shadows than the truth's, which the object's light reflected onto the ground
+// brightens: the zenith-sun test 1.7x its darkening). Returns the lit fraction and how far the
+// blockers are (world units along the light; 1e30 for none).
+fn soft_lit(r: u32, rec: MapReceiver, pixel: vec2<u32>) -> vec2<f32> {
     let view = maps[r].views[0];
     let clip = view.matrix * vec4<f32>(rec.p, 1.0);
     let ndc = clip.xyz / clip.w;
     // between the light and the map's near plane nothing can shadow it
     if ndc.z < 0.0 {
-        return 1.0;
+        return vec2<f32>(1.0, 1e30);
     }
     let depth = min(ndc.z, 1.0);
     let res = view.params.w;
@@ -97,7 +105,7 @@ fn soft_lit(r: u32, rec: MapReceiver, pixel: vec2<u32>) -> f32 {
         sum += b.x * b.y;
     }
     if blockers == 0.0 {
-        return 1.0;
+        return vec2<f32>(1.0, 1e30);
     }
     let blocker = sum / blockers;
     let radius = clamp((depth - blocker) * depth_span * tan_a / texel, 0.5, max_r);
@@ -108,15 +116,16 @@ fn soft_lit(r: u32, rec: MapReceiver, pixel: vec2<u32>) -> f32 {
         let bias = (length(o) + 1.5) * texel * slope / depth_span;
         shadowed += blocked(r, floor(centre + o), depth - bias).x;
     }
-    return 1.0 - shadowed / f32(nf);
+    return vec2<f32>(1.0 - shadowed / f32(nf), max(depth - blocker, 0.0) * depth_span);
 }
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    if id.x >= params.width || id.y >= params.height {
+    let xy = id.xy + vec2<u32>(params.origin_x, params.origin_y);
+    if xy.x >= params.width || xy.y >= params.height {
         return;
     }
-    let k = id.y * params.width + id.x;
+    let k = xy.y * params.width + xy.x;
     let px = pixels[k];
     if px.slot == 0xffffffffu {
         return;
@@ -128,7 +137,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     var sum = vec4<f32>(0.0);
     for (var r = 0u; r < params.reps; r++) {
         let rect = rects[r];
-        if id.x < rect.x || id.y < rect.y || id.x >= rect.z || id.y >= rect.w {
+        if xy.x < rect.x || xy.y < rect.y || xy.x >= rect.z || xy.y >= rect.w {
             continue;
         }
         let base = (params.first_rep + r) * params.slots + px.slot;
@@ -146,15 +155,21 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         let rec = map_receiver(light, config, maps[r].views[0].params, g.xyz, ng);
         let technique = u32(config.x);
         var lit = 0.0;
+        // how far the blocker is: at the object's contact, the receiver sees its underside,
+        // not the side its sources face, and keeps none of the object's radiance
+        var apart = 1e30;
         if technique == 2u && maps[r].pcss.x > 0.5 {
-            lit = soft_lit(r, rec, id.xy);
+            let soft = soft_lit(r, rec, xy);
+            lit = soft.x;
+            apart = soft.y;
         } else {
             let layer = map_layer(light, forward, config, rec.p);
             if layer != NO_LAYER {
                 lit = view_lit(maps[r].views[layer], technique, i32(config.z), shadow_maps, i32(layer + u32(forward.w)), rec.p);
             }
         }
-        sum += (1.0 - lit) * t;
+        let keep = mix(vec3<f32>(1.0), keeps[params.first_rep + r].rgb, clamp(apart / max(params.object_radius, 1e-30), 0.0, 1.0));
+        sum += (1.0 - lit) * t * vec4<f32>(keep, 1.0);
     }
     darkening[k] += sum;
 }

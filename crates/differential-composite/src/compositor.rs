@@ -81,6 +81,11 @@ pub struct Compositor {
     /// 1 - L_object / L_sources per channel, L_object the object's radiance facing away from
     /// the representative's direction. `false`: the paper's, the source's light removed whole.
     pub object_replaces_sources: bool,
+    /// Whether the object's irradiance probe sees the model darkened by the object's own
+    /// shadow (each representative whose direction a sphere standing for the object blocks
+    /// from the model point takes its transfer there): the light the object's underside gets
+    /// back from the ground it shadows. `false`: the model as captured.
+    pub object_shadows_probe: bool,
     /// The radiance the photograph saturates at, if it clips: the HDR composite is clipped
     /// there as the camera would have (its clipped pixels in `photo_hdr` may be raised above
     /// it, so that a shadow cast on them darkens from their estimated radiance).
@@ -125,6 +130,12 @@ pub struct RepTransfer {
     /// The mean radiance over the solid angle of the distant sources it stands for (zero for
     /// patches).
     pub source_radiance: Vec3,
+    /// What of its `radiance` a blocked receiver loses, per channel, where the object stands
+    /// in its sources' place with its own radiance ([`Compositor::object_replaces_sources`]);
+    /// 1 elsewhere. `radiance` is the sources' whole transfer: the darkening is it times this
+    /// (the GPU's soft masks lift it toward 1 at contact, where the receiver sees the object's
+    /// underside, not the side the sources face).
+    pub keep: Vec3,
 }
 
 /// A frame's transfers.
@@ -237,6 +248,7 @@ impl Compositor {
             probe,
             object_lights: Vec::new(),
             object_replaces_sources: false,
+            object_shadows_probe: false,
             clip: None,
             bvh,
         })
@@ -335,6 +347,7 @@ impl Compositor {
                     sources: rep.sources,
                     half_angle: half_angle.min(std::f32::consts::FRAC_PI_2 * 0.9),
                     source_radiance: if solid_angle > 0.0 { power / solid_angle } else { Vec3::ZERO },
+                    keep: Vec3::ONE,
                 }
             })
             .collect();
@@ -343,7 +356,11 @@ impl Compositor {
         let sets: Vec<u8> = out.iter().map(|r| self.set_of[r.origin_source as usize]).collect();
         let transfers = t.elapsed();
         let t = Instant::now();
-        let object_irradiance = self.irradiance_at(object.centre);
+        let object_irradiance = if self.object_shadows_probe {
+            self.shadowed_irradiance_at(object, &out)
+        } else {
+            self.irradiance_at(object.centre)
+        };
         let object_lights: Vec<DistantLight> =
             self.object_lights.iter().filter(|l| self.bvh.escapes(object.centre, l.direction)).copied().collect();
         let shading = t.elapsed();
@@ -353,7 +370,15 @@ impl Compositor {
             // sources: seen from high sources' receivers, under the object, it faces ground in
             // its own shadow (its light from the sky alone); from low ones', the lit ground
             // beyond (all of its light): blended by the source's elevation
-            let full = FrameTransfers { object_irradiance, object_lights: object_lights.clone(), ..Default::default() };
+            // (the object as captured: the light its shadow takes from the ground under it is
+            // the ground's own loss, already in the representatives' transfers)
+            let unshadowed =
+                if self.object_shadows_probe { self.irradiance_at(object.centre) } else { object_irradiance };
+            let full = FrameTransfers {
+                object_irradiance: unshadowed,
+                object_lights: object_lights.clone(),
+                ..Default::default()
+            };
             let sky = FrameTransfers { object_irradiance: self.sky_irradiance_at(object.centre), ..full.clone() };
             for rep in &mut out {
                 let Origin::Direction(d) = rep.origin else { continue };
@@ -362,9 +387,10 @@ impl Compositor {
                 let e = facing(&full).lerp(facing(&sky), d.y.clamp(0.0, 1.0));
                 let own = object.albedo / std::f32::consts::PI * e;
                 let keep = Vec3::from_array(std::array::from_fn(|c| {
-                    if sources[c] > 0.0 { (1.0 - own[c] / sources[c]).clamp(0.0, 1.0) } else { 1.0 }
+                    let k = 1.0 - own[c] / sources[c];
+                    if sources[c] > 0.0 && k.is_finite() { k.clamp(0.0, 1.0) } else { 1.0 }
                 }));
-                rep.radiance.iter_mut().for_each(|v| *v *= keep);
+                rep.keep = keep;
             }
         }
         self.intensity_transfers(&mut out, &receiver_slots, &sets);
@@ -390,7 +416,7 @@ impl Compositor {
         let mut column = Vec::with_capacity(reps.len());
         for &s in slots {
             column.clear();
-            column.extend(reps.iter().map(|r| r.radiance[s]));
+            column.extend(reps.iter().map(|r| r.radiance[s] * r.keep));
             let lost = crate::ldr::intensity_transfers(&self.response, self.vertex_radiance[s], &column, sets);
             for (r, v) in reps.iter_mut().zip(lost) {
                 r.intensity[s] = v;
@@ -403,18 +429,59 @@ impl Compositor {
     /// says.
     #[must_use]
     pub fn irradiance_at(&self, p: Vec3) -> Sh9 {
-        self.probe_at(p, true)
+        self.probe_at(p, true, None)
     }
 
     /// [`Compositor::irradiance_at`] with what the model reflects left out (the directions
     /// where probe rays meet it are black): the light from the sky alone.
     #[must_use]
     pub fn sky_irradiance_at(&self, p: Vec3) -> Sh9 {
-        self.probe_at(p, false)
+        self.probe_at(p, false, None)
     }
 
-    fn probe_at(&self, p: Vec3, with_model: bool) -> Sh9 {
-        let model = |patch: u32| if with_model { self.model.patches[patch as usize].radiance } else { Vec3::ZERO };
+    /// [`Compositor::irradiance_at`] the object's centre, the model darkened by the object's
+    /// shadow ([`Compositor::object_shadows_probe`]): the object stands in as the sphere of
+    /// its bounding box's mean half side about the box's centre.
+    fn shadowed_irradiance_at(&self, object: &SyntheticObject, reps: &[RepTransfer]) -> Sh9 {
+        let b = object.bounds();
+        let (centre, radius) = (0.5 * (b.min + b.max), (b.max - b.min).dot(Vec3::ONE) / 6.0);
+        let mut receiver_of = vec![u32::MAX; self.model.patches.len()];
+        for (k, &r) in self.prepared.receivers.iter().enumerate() {
+            receiver_of[r as usize] = k as u32;
+        }
+        let blocks = |q: Vec3, d: Vec3| {
+            let oc = q - centre;
+            let (b, c) = (oc.dot(d), oc.length_squared() - radius * radius);
+            let disc = b * b - c;
+            disc > 0.0 && -b + disc.sqrt() > 0.0 && c > 0.0
+        };
+        let shade = |patch: u32, q: Vec3| {
+            let Some(&k) = receiver_of.get(patch as usize).filter(|&&k| k != u32::MAX) else { return Vec3::ONE };
+            let slots = 4 * k as usize..4 * k as usize + 4;
+            let l: Vec3 = self.vertex_radiance[slots.clone()].iter().sum();
+            let mut lost = Vec3::ZERO;
+            for rep in reps {
+                if let Origin::Direction(d) = rep.origin
+                    && blocks(q, d)
+                {
+                    lost += rep.radiance[slots.clone()].iter().sum::<Vec3>();
+                }
+            }
+            Vec3::from_array(std::array::from_fn(
+                |c| if l[c] > 0.0 { (1.0 - lost[c] / l[c]).clamp(0.0, 1.0) } else { 1.0 },
+            ))
+        };
+        self.probe_at(object.centre, true, Some(&shade))
+    }
+
+    fn probe_at(&self, p: Vec3, with_model: bool, shade: Option<&(dyn Fn(u32, Vec3) -> Vec3 + Sync)>) -> Sh9 {
+        let model = |patch: u32, t: f32, d: Vec3| {
+            if !with_model {
+                return Vec3::ZERO;
+            }
+            let l = self.model.patches[patch as usize].radiance;
+            shade.map_or(l, |f| l * f(patch, p + d * t))
+        };
         // 2 x 2 rays a texel: a small bright source (the lamp, a third of a texel at 32 x 16)
         // must not hinge on whether a texel centre finds it
         let (w, h) = (64u32, 32u32);
@@ -426,8 +493,8 @@ impl Compositor {
         let map = |d: Vec3| self.map.as_ref().map_or(Vec3::ZERO, |m| m.lookup(d));
         let radiance = |d: Vec3| match (self.bvh.first_hit(p, d), &self.probe) {
             // the model in place of the map, which the exact projection already holds
-            (Some((patch, _)), ObjectProbe::Map(_)) => model(patch) - map(d),
-            (Some((patch, _)), _) => model(patch),
+            (Some((patch, t)), ObjectProbe::Map(_)) => model(patch, t, d) - map(d),
+            (Some((patch, t)), _) => model(patch, t, d),
             (None, ObjectProbe::Map(_)) => Vec3::ZERO,
             (None, _) if in_a_light(d) => Vec3::ZERO,
             (None, _) => map(d),

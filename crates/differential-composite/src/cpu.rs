@@ -117,11 +117,11 @@ pub fn composite(
                     let p = px.position + px.normal * eps;
                     let slot = px.slot as usize;
                     for r in frame.reps.iter().filter(|r| bvh.blocks(p, &r.origin)) {
-                        let per_vertex = match mode {
-                            Mode::Hdr => &r.radiance,
-                            Mode::Ldr => &r.intensity,
+                        let (per_vertex, keep) = match mode {
+                            Mode::Hdr => (&r.radiance, r.keep),
+                            Mode::Ldr => (&r.intensity, Vec3::ONE),
                         };
-                        sum += (0..4).map(|v| px.weights[v] * per_vertex[slot + v]).sum::<Vec3>();
+                        sum += keep * (0..4).map(|v| px.weights[v] * per_vertex[slot + v]).sum::<Vec3>();
                     }
                     sum *= c.pixel_scale[k];
                 }

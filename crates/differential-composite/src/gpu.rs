@@ -149,7 +149,8 @@ struct MaskParams {
     slots: u32,
     reps: u32,
     first_rep: u32,
-    pad: [u32; 3],
+    origin: [u32; 2],
+    object_radius: f32,
 }
 
 #[repr(C)]
@@ -493,15 +494,40 @@ impl GpuCompositor {
             gpu.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
         };
         let transfer_buffer = buffer("transfers", bytemuck::cast_slice(&transfers), wgpu::BufferUsages::STORAGE);
+        // per representative what a blocked receiver keeps of its transfer (LDR: its
+        // intensities hold it already)
+        let mut keeps: Vec<[f32; 4]> = frame
+            .reps
+            .iter()
+            .map(|r| if mode == Mode::Hdr { r.keep.extend(1.0).to_array() } else { [1.0; 4] })
+            .collect();
+        if keeps.is_empty() {
+            keeps.push([1.0; 4]);
+        }
+        let keep_buffer = buffer("keeps", bytemuck::cast_slice(&keeps), wgpu::BufferUsages::STORAGE);
         encoder.clear_buffer(&self.darkening, 0, None);
         for ((array, mine), &(first, _)) in maps.arrays.iter().zip(&maps.params).zip(&maps.batches) {
+            // the dispatch covers the union of the batch's rectangles, no more
+            let mut union = [w, h, 0, 0];
+            for r in &rects[first..first + mine.len()] {
+                if r[2] > r[0] && r[3] > r[1] {
+                    union = [union[0].min(r[0]), union[1].min(r[1]), union[2].max(r[2]), union[3].max(r[3])];
+                }
+            }
+            if union[2] <= union[0] || union[3] <= union[1] {
+                continue;
+            }
             let uniform = MaskParams {
                 width: w,
                 height: h,
                 slots: slots as u32,
                 reps: mine.len() as u32,
                 first_rep: first as u32,
-                pad: [0; 3],
+                origin: [union[0], union[1]],
+                object_radius: {
+                    let b = object.bounds();
+                    0.5 * (b.max - b.min).length()
+                },
             };
             let uniform = buffer("mask params", bytemuck::bytes_of(&uniform), wgpu::BufferUsages::UNIFORM);
             let params = buffer("mask maps", bytemuck::cast_slice(mine), wgpu::BufferUsages::STORAGE);
@@ -526,12 +552,13 @@ impl GpuCompositor {
                     wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&depth) },
                     wgpu::BindGroupEntry { binding: 5, resource: self.darkening.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 6, resource: batch_rects.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 7, resource: keep_buffer.as_entire_binding() },
                 ],
             });
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor::default());
             pass.set_pipeline(&self.masks);
             pass.set_bind_group(0, &bind, &[]);
-            pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
+            pass.dispatch_workgroups((union[2] - union[0]).div_ceil(8), (union[3] - union[1]).div_ceil(8), 1);
         }
     }
 

@@ -25,6 +25,9 @@ pub(crate) fn run(args: &CompositeArgs) -> Result<(), String> {
     if !(args.fov > 0.0 && args.fov < 180.0) {
         return Err(format!("--fov {}: degrees in (0, 180)", args.fov));
     }
+    if !(1..=256).contains(&args.lights) {
+        return Err(format!("--lights {}: 1 to 256", args.lights));
+    }
     let gpu_settings = differential_composite::gpu::GpuSettings {
         pcss: (!args.hard_shadows).then_some(shadowmap_paraboloid::Pcss {
             blocker_samples: args.pcss_samples.div_ceil(2).max(1),
@@ -78,6 +81,7 @@ pub(crate) fn run(args: &CompositeArgs) -> Result<(), String> {
             },
             ..BackdropSettings::default().preprocess
         },
+        lights: args.lights,
         ..BackdropSettings::default()
     };
     let t = std::time::Instant::now();

@@ -81,6 +81,10 @@ pub struct CompositeArgs {
     /// Backdrop: the radius of the ground disc the map's lower half is projected onto, metres.
     #[arg(long, default_value_t = real_scene::Backdrop::DEFAULT_GROUND_RADIUS)]
     pub ground_radius: f32,
+    /// Backdrop and photograph: lights extracted from the map, the shadow sources (more:
+    /// narrower cones, truer soft and contact shadows, more shadow maps).
+    #[arg(long, default_value_t = 32)]
+    pub lights: usize,
     /// Backdrop: samples a pixel of the path-traced truth (it is two renders of half as many,
     /// whose difference gives its own noise).
     #[arg(long, default_value_t = 1024)]

@@ -242,6 +242,7 @@ impl BackdropSession {
         compositor.probe = differential_composite::ObjectProbe::Map(sh);
         compositor.object_lights = direct;
         compositor.object_replaces_sources = true;
+        compositor.object_shadows_probe = true;
         let residual = compositor.lights.len() - main;
         let ground = backdrop.ground_from(&radiance, e, settings.ground_texels);
         Ok(Self { map, backdrop, compositor, ground, lights: (main, residual), photo })

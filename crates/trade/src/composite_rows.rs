@@ -131,7 +131,7 @@ pub fn figure3_datasets(session: &Session, frame: &FrameTransfers, count: usize,
     let mut vertices: Vec<Dataset> = (0..c.prepared.transfers.slots)
         .filter_map(|s| {
             let mut t: Vec<glam::Vec3> =
-                frame.reps.iter().map(|r| r.radiance[s]).filter(|v| v.max_element() > 0.0).collect();
+                frame.reps.iter().map(|r| r.radiance[s] * r.keep).filter(|v| v.max_element() > 0.0).collect();
             if t.len() < sources {
                 return None;
             }

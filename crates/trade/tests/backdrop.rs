@@ -349,3 +349,28 @@ fn an_hdr_photo_with_clipped_pixels_keeps_its_shadow() {
     assert!(ours < 0.7 * naive, "{ours} against {naive} read as unclipped");
     assert!(ours < 1.3 * full + 0.5, "{ours} against {full} unclipped");
 }
+
+#[test]
+fn the_objects_underside_sees_its_own_shadow() {
+    // a sun at the zenith: the ground under the sphere is in its shadow, so the light the
+    // sphere's underside gets back from the ground is less than the captured ground would give;
+    // its top, which sees the sky, is unchanged
+    let at = Vec3::new(0.0, 0.0, 2.5);
+    let object = sphere(at, 1.0);
+    let s = BackdropSession::new(map(Some((Vec3::Y, 3e3))), camera(Vec3::new(0.0, 1.6, 0.0), at), &settings(20.0))
+        .unwrap();
+    let c = &s.compositor;
+    assert!(c.object_shadows_probe, "the backdrop's probe sees the object's shadow");
+    let frame = c.frame(&object, 50);
+    let captured = differential_composite::FrameTransfers {
+        object_irradiance: c.irradiance_at(object.centre),
+        ..frame.clone()
+    };
+    let (down, down_captured) = (frame.object_irradiance_at(Vec3::NEG_Y), captured.object_irradiance_at(Vec3::NEG_Y));
+    let (up, up_captured) = (frame.object_irradiance_at(Vec3::Y), captured.object_irradiance_at(Vec3::Y));
+    assert!(
+        luminance(down) < 0.8 * luminance(down_captured) && luminance(down) > 0.0,
+        "underside: {down} against {down_captured} captured"
+    );
+    assert!((luminance(up) / luminance(up_captured) - 1.0).abs() < 0.05, "top: {up} against {up_captured}");
+}
