@@ -48,6 +48,8 @@ pub enum Format {
     Gltf,
     /// Binary glTF 2.0 (`.glb`).
     Glb,
+    /// A PNG or JPEG photograph (`--photo`).
+    Png,
 }
 
 /// Loads a file's bytes under a name: `Err` is the loader's message.

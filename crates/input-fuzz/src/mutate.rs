@@ -70,6 +70,8 @@ pub fn header_len(bytes: &[u8], format: Format) -> usize {
         Format::Json | Format::Gltf => bytes.len().min(256),
         // the container's header and chunk header, and the start of the JSON
         Format::Glb => bytes.len().min(96),
+        // a PNG's signature and IHDR; a JPEG's first markers
+        Format::Png => bytes.len().min(64),
     }
 }
 
@@ -150,6 +152,7 @@ pub fn mutate(seed: &[u8], format: Format, rng: &mut impl Rng) -> Vec<u8> {
                 Format::Json => json(&mut bytes, rng),
                 Format::Gltf => crate::model::mutate(&mut bytes, false, rng),
                 Format::Glb => crate::model::mutate(&mut bytes, true, rng),
+                Format::Png => png(&mut bytes, rng),
             }
         }
     }
@@ -409,4 +412,21 @@ pub(crate) fn json(bytes: &mut Vec<u8>, rng: &mut impl Rng) {
             }
         }
     };
+}
+
+/// A PNG's IHDR width or height (bytes 16-23, big-endian) set to an extreme: the size a
+/// decoder believes before it reads a pixel (a JPEG's bytes there are flipped alike).
+fn png(bytes: &mut [u8], rng: &mut impl Rng) {
+    if bytes.len() < 24 {
+        return;
+    }
+    let at = if rng.random_bool(0.5) { 16 } else { 20 };
+    let v: u32 = match rng.random_range(0..5) {
+        0 => 0,
+        1 => 1,
+        2 => u32::MAX,
+        3 => 1 << rng.random_range(10..31),
+        _ => rng.random(),
+    };
+    bytes[at..at + 4].copy_from_slice(&v.to_be_bytes());
 }

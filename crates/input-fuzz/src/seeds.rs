@@ -289,6 +289,30 @@ pub fn glb() -> Vec<Vec<u8>> {
         .collect()
 }
 
+/// Photographs as `--photo` reads them: an 8-bit and a 16-bit PNG (a channel at its top code,
+/// clipped) and a JPEG.
+#[must_use]
+pub fn photos() -> (Vec<Vec<u8>>, Vec<Vec<u8>>) {
+    let encode = |image: image::DynamicImage, format| {
+        let mut out = std::io::Cursor::new(Vec::new());
+        image.write_to(&mut out, format).map(|()| out.into_inner()).ok()
+    };
+    let rgb8 = image::RgbImage::from_fn(24, 16, |x, y| image::Rgb([(x * 10) as u8, (y * 16) as u8, 255]));
+    let rgb16 = image::ImageBuffer::<image::Rgb<u16>, _>::from_fn(12, 8, |x, y| {
+        image::Rgb([(x * 5000) as u16, (y * 8000) as u16, u16::MAX])
+    });
+    let png = [
+        encode(image::DynamicImage::ImageRgb8(rgb8.clone()), image::ImageFormat::Png),
+        encode(image::DynamicImage::ImageRgb16(rgb16), image::ImageFormat::Png),
+    ];
+    let jpeg = [encode(image::DynamicImage::ImageRgb8(rgb8), image::ImageFormat::Jpeg)];
+    (png.into_iter().flatten().collect(), jpeg.into_iter().flatten().collect())
+}
+
+/// Pixels a fuzzed photograph may have: its decoding buffers (16 bytes a pixel) and the
+/// photograph's own stay within [`crate::CASE_ALLOCATION_LIMIT`].
+pub const PHOTO_MAX_PIXELS: u64 = 1 << 20;
+
 /// The glTF import's options when fuzzed: a small camera and a million triangles at most, so a
 /// case that claims the most allowed stays within [`crate::CASE_ALLOCATION_LIMIT`].
 #[must_use]
@@ -303,7 +327,8 @@ pub fn gltf_options() -> scene::import::GltfOptions {
 
 /// The loaders the commands use, on the seeds above: maps (`info`, `extract`, `--envmap`, the
 /// `ambient.exr` beside a `lights.json`, read signed), images (`compare`) and `lights.json`
-/// (`render --lights`), models (every command's scene or `--object` path).
+/// (`render --lights`), models (every command's scene or `--object` path), photographs
+/// (`composite --photo`).
 #[must_use]
 pub fn library_targets() -> Vec<Target> {
     let options = LoadOptions { max_pixels: FUZZ_MAX_PIXELS, ..LoadOptions::default() };
@@ -319,7 +344,11 @@ pub fn library_targets() -> Vec<Target> {
     let model = |bytes: &[u8], path: &std::path::Path| {
         scene::import::load_gltf_from_bytes(bytes, path, &gltf_options()).map(|_| ()).map_err(|e| e.to_string())
     };
+    let photo = |bytes: &[u8], path: &std::path::Path| {
+        real_scene::Photograph::from_bytes(bytes, path, 2.2, PHOTO_MAX_PIXELS).map(|_| ()).map_err(|e| e.to_string())
+    };
     let (hdr, exr) = (hdr(), exr());
+    let (png, jpeg) = photos();
     vec![
         Target {
             name: "map.hdr",
@@ -355,5 +384,15 @@ pub fn library_targets() -> Vec<Target> {
         },
         Target { name: "model.gltf", extension: "gltf", format: Format::Gltf, seeds: gltf(), run: Box::new(model) },
         Target { name: "model.glb", extension: "glb", format: Format::Glb, seeds: glb(), run: Box::new(model) },
+        Target { name: "photo.png", extension: "png", format: Format::Png, seeds: png, run: Box::new(photo) },
+        Target { name: "photo.jpg", extension: "jpg", format: Format::Png, seeds: jpeg, run: Box::new(photo) },
+        Target {
+            name: "photo.exr",
+            extension: "exr",
+            format: Format::Exr,
+            // the maps' seeds but the signed one (a photograph has no negative radiance)
+            seeds: exr.into_iter().filter(|s| photo(s, std::path::Path::new("seed")).is_ok()).collect(),
+            run: Box::new(photo),
+        },
     ]
 }

@@ -27,6 +27,7 @@ fn mutations_never_panic_and_change_the_file() {
         (Format::Json, seeds::lights_json()),
         (Format::Gltf, seeds::gltf()),
         (Format::Glb, seeds::glb()),
+        (Format::Png, seeds::photos().0),
     ];
     for (format, seeds) in sets {
         let mut changed = 0;

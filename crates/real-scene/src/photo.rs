@@ -104,11 +104,30 @@ impl Photograph {
             return Err(fail(format!("a response gamma of {gamma} (0.1 to 10)")));
         }
         let bytes = std::fs::read(path).map_err(|e| fail(e.to_string()))?;
+        Self::from_bytes(&bytes, path, gamma, MAX_PHOTO_PIXELS)
+    }
+
+    /// [`Photograph::open`] from a file's bytes; `path` names it in errors, and at most
+    /// `max_pixels` (and [`MAX_PHOTO_PIXELS`]) are decoded.
+    ///
+    /// # Errors
+    /// As [`Photograph::open`].
+    pub fn from_bytes(
+        bytes: &[u8],
+        path: &std::path::Path,
+        gamma: f32,
+        max_pixels: u64,
+    ) -> Result<Self, RealSceneError> {
+        let fail = |reason: String| RealSceneError::Photo { path: path.to_path_buf(), reason };
+        if !(gamma.is_finite() && (0.1..=10.0).contains(&gamma)) {
+            return Err(fail(format!("a response gamma of {gamma} (0.1 to 10)")));
+        }
+        let max_pixels = max_pixels.min(MAX_PHOTO_PIXELS);
         if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) || bytes.starts_with(b"#?") {
             let image = envmap_sphere::load_rgb_image_from_bytes(
-                &bytes,
+                bytes,
                 path,
-                &envmap_sphere::LoadOptions { max_pixels: MAX_PHOTO_PIXELS, ..envmap_sphere::LoadOptions::default() },
+                &envmap_sphere::LoadOptions { max_pixels, ..envmap_sphere::LoadOptions::default() },
             )
             .map_err(|e| fail(one_line(&e).replace(&format!("{}: ", path.display()), "")))?;
             if image.pixels.iter().any(|p| p.min_element() < 0.0) {
@@ -117,7 +136,7 @@ impl Photograph {
             return Ok(Self::from_hdr(image.width, image.height, image.pixels));
         }
         let guess = || {
-            image::ImageReader::new(std::io::Cursor::new(&bytes[..]))
+            image::ImageReader::new(std::io::Cursor::new(bytes))
                 .with_guessed_format()
                 .map_err(|e| fail(format!("unreadable image: {}", one_line(&e))))
         };
@@ -126,7 +145,7 @@ impl Photograph {
             return Err(fail("not a PNG, JPEG, OpenEXR or Radiance HDR image".into()));
         }
         let (w, h) = reader.into_dimensions().map_err(|e| fail(format!("unreadable image: {}", one_line(&e))))?;
-        check_size(w, h).map_err(fail)?;
+        check_size(w, h, max_pixels).map_err(fail)?;
         let mut reader = guess()?;
         let mut limits = image::Limits::default();
         // 16-bit RGBA and the decoder's own buffers
@@ -234,10 +253,10 @@ impl Photograph {
     }
 }
 
-fn check_size(w: u32, h: u32) -> Result<(), String> {
-    if w == 0 || h == 0 || w > MAX_PHOTO_SIDE || h > MAX_PHOTO_SIDE || u64::from(w) * u64::from(h) > MAX_PHOTO_PIXELS {
+fn check_size(w: u32, h: u32, max_pixels: u64) -> Result<(), String> {
+    if w == 0 || h == 0 || w > MAX_PHOTO_SIDE || h > MAX_PHOTO_SIDE || u64::from(w) * u64::from(h) > max_pixels {
         return Err(format!(
-            "{w} x {h} pixels: a photograph is 1 to {MAX_PHOTO_SIDE} pixels a side, at most {MAX_PHOTO_PIXELS} in all"
+            "{w} x {h} pixels: a photograph is 1 to {MAX_PHOTO_SIDE} pixels a side, at most {max_pixels} in all"
         ));
     }
     Ok(())

@@ -357,15 +357,13 @@ fn the_objects_underside_sees_its_own_shadow() {
     // its top, which sees the sky, is unchanged
     let at = Vec3::new(0.0, 0.0, 2.5);
     let object = sphere(at, 1.0);
-    let s = BackdropSession::new(map(Some((Vec3::Y, 3e3))), camera(Vec3::new(0.0, 1.6, 0.0), at), &settings(20.0))
-        .unwrap();
+    let s =
+        BackdropSession::new(map(Some((Vec3::Y, 3e3))), camera(Vec3::new(0.0, 1.6, 0.0), at), &settings(20.0)).unwrap();
     let c = &s.compositor;
     assert!(c.object_shadows_probe, "the backdrop's probe sees the object's shadow");
     let frame = c.frame(&object, 50);
-    let captured = differential_composite::FrameTransfers {
-        object_irradiance: c.irradiance_at(object.centre),
-        ..frame.clone()
-    };
+    let captured =
+        differential_composite::FrameTransfers { object_irradiance: c.irradiance_at(object.centre), ..frame.clone() };
     let (down, down_captured) = (frame.object_irradiance_at(Vec3::NEG_Y), captured.object_irradiance_at(Vec3::NEG_Y));
     let (up, up_captured) = (frame.object_irradiance_at(Vec3::Y), captured.object_irradiance_at(Vec3::Y));
     assert!(
