@@ -406,3 +406,17 @@ fn radiance_primaries_line_is_ignored() {
     let p = plain.0.pixel(1, 1);
     assert!((p - Vec3::new(1.0, 0.5, 0.25)).abs().max_element() < 0.01, "{p}");
 }
+
+#[test]
+fn b44_blocks_that_wrap_decode_without_aborting() {
+    // found by `cargo xtask fuzz`: a B44 block whose deltas wrap below zero made the exr crate's
+    // decoder thread panic under dev's overflow checks, aborting the process; its arithmetic
+    // wraps by design (the workspace turns the checks off for it)
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/fuzz_b44_wrap.exr");
+    let bytes = std::fs::read(&path).expect("the case");
+    let result = envmap_sphere::load_rgb_image_from_bytes(&bytes, &path, &LoadOptions::default());
+    match result {
+        Ok(image) => assert_eq!(image.pixels.len(), image.width as usize * image.height as usize),
+        Err(e) => assert!(e.to_string().contains("fuzz_b44_wrap.exr") && !e.to_string().contains('\n'), "{e}"),
+    }
+}
