@@ -10,6 +10,7 @@ use std::time::{Duration, Instant};
 use envmap_sphere::{EnvMap, Sh9};
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
+use rayon::prelude::*;
 use real_scene::{CameraResponse, RealScene, Visibility, luminance};
 use scene::DistantLight;
 use shaft_hierarchy::preprocess::{Origin, Prepared, Source};
@@ -90,6 +91,8 @@ pub struct Compositor {
     /// there as the camera would have (its clipped pixels in `photo_hdr` may be raised above
     /// it, so that a shadow cast on them darkens from their estimated radiance).
     pub clip: Option<f32>,
+    /// Per model patch, its index among the prepared receivers (`u32::MAX` for none).
+    receiver_of: Vec<u32>,
     bvh: Box<dyn Visibility>,
 }
 
@@ -226,7 +229,11 @@ impl Compositor {
             prepared.receivers.iter().flat_map(|&r| [model.patches[r as usize].radiance; 4]).collect();
         let mut rng = rand_pcg::Pcg32::seed_from_u64(3);
         let set_of = prepared.sources.iter().map(|_| (rng.random::<u32>() & 1) as u8).collect();
-        let pixels = pixel_refs(&model, &prepared, bvh.as_ref());
+        let mut receiver_of = vec![u32::MAX; model.patches.len()];
+        for (k, &r) in prepared.receivers.iter().enumerate() {
+            receiver_of[r as usize] = k as u32;
+        }
+        let pixels = pixel_refs(&model, &receiver_of, bvh.as_ref());
         let pixel_scale = vec![Vec3::ONE; pixels.len()];
         let probe = ObjectProbe::Lights(lights.len());
         Ok(Self {
@@ -250,6 +257,7 @@ impl Compositor {
             object_replaces_sources: false,
             object_shadows_probe: false,
             clip: None,
+            receiver_of,
             bvh,
         })
     }
@@ -356,11 +364,11 @@ impl Compositor {
         let sets: Vec<u8> = out.iter().map(|r| self.set_of[r.origin_source as usize]).collect();
         let transfers = t.elapsed();
         let t = Instant::now();
-        let object_irradiance = if self.object_shadows_probe {
-            self.shadowed_irradiance_at(object, &out)
-        } else {
-            self.irradiance_at(object.centre)
+        let probes = {
+            let shadow = self.object_shadows_probe.then(|| self.object_shadow(object, &out));
+            self.probes_at(object.centre, shadow.as_ref().map(|f| f as &(dyn Fn(u32, Vec3) -> Vec3 + Sync)))
         };
+        let object_irradiance = probes.shadowed;
         let object_lights: Vec<DistantLight> =
             self.object_lights.iter().filter(|l| self.bvh.escapes(object.centre, l.direction)).copied().collect();
         let shading = t.elapsed();
@@ -372,14 +380,12 @@ impl Compositor {
             // beyond (all of its light): blended by the source's elevation
             // (the object as captured: the light its shadow takes from the ground under it is
             // the ground's own loss, already in the representatives' transfers)
-            let unshadowed =
-                if self.object_shadows_probe { self.irradiance_at(object.centre) } else { object_irradiance };
             let full = FrameTransfers {
-                object_irradiance: unshadowed,
+                object_irradiance: probes.full,
                 object_lights: object_lights.clone(),
                 ..Default::default()
             };
-            let sky = FrameTransfers { object_irradiance: self.sky_irradiance_at(object.centre), ..full.clone() };
+            let sky = FrameTransfers { object_irradiance: probes.sky, ..full.clone() };
             for rep in &mut out {
                 let Origin::Direction(d) = rep.origin else { continue };
                 let sources = rep.source_radiance;
@@ -429,34 +435,35 @@ impl Compositor {
     /// says.
     #[must_use]
     pub fn irradiance_at(&self, p: Vec3) -> Sh9 {
-        self.probe_at(p, true, None)
+        self.probes_at(p, None).full
     }
 
     /// [`Compositor::irradiance_at`] with what the model reflects left out (the directions
     /// where probe rays meet it are black): the light from the sky alone.
     #[must_use]
     pub fn sky_irradiance_at(&self, p: Vec3) -> Sh9 {
-        self.probe_at(p, false, None)
+        self.probes_at(p, None).sky
     }
 
-    /// [`Compositor::irradiance_at`] the object's centre, the model darkened by the object's
-    /// shadow ([`Compositor::object_shadows_probe`]): the object stands in as the sphere of
-    /// its bounding box's mean half side about the box's centre.
-    fn shadowed_irradiance_at(&self, object: &SyntheticObject, reps: &[RepTransfer]) -> Sh9 {
+    /// What a ground point `q` of model patch `patch` keeps of its radiance under the object's
+    /// shadow ([`Compositor::object_shadows_probe`]): each representative whose direction the
+    /// sphere of the object's bounding box's mean half side, about the box's centre, blocks
+    /// from `q` takes its transfer there.
+    fn object_shadow<'a>(
+        &'a self,
+        object: &SyntheticObject,
+        reps: &'a [RepTransfer],
+    ) -> impl Fn(u32, Vec3) -> Vec3 + Sync + 'a {
         let b = object.bounds();
         let (centre, radius) = (0.5 * (b.min + b.max), (b.max - b.min).dot(Vec3::ONE) / 6.0);
-        let mut receiver_of = vec![u32::MAX; self.model.patches.len()];
-        for (k, &r) in self.prepared.receivers.iter().enumerate() {
-            receiver_of[r as usize] = k as u32;
-        }
-        let blocks = |q: Vec3, d: Vec3| {
+        let blocks = move |q: Vec3, d: Vec3| {
             let oc = q - centre;
             let (b, c) = (oc.dot(d), oc.length_squared() - radius * radius);
             let disc = b * b - c;
             disc > 0.0 && -b + disc.sqrt() > 0.0 && c > 0.0
         };
-        let shade = |patch: u32, q: Vec3| {
-            let Some(&k) = receiver_of.get(patch as usize).filter(|&&k| k != u32::MAX) else { return Vec3::ONE };
+        move |patch: u32, q: Vec3| {
+            let Some(&k) = self.receiver_of.get(patch as usize).filter(|&&k| k != u32::MAX) else { return Vec3::ONE };
             let slots = 4 * k as usize..4 * k as usize + 4;
             let l: Vec3 = self.vertex_radiance[slots.clone()].iter().sum();
             let mut lost = Vec3::ZERO;
@@ -470,57 +477,73 @@ impl Compositor {
             Vec3::from_array(std::array::from_fn(
                 |c| if l[c] > 0.0 { (1.0 - lost[c] / l[c]).clamp(0.0, 1.0) } else { 1.0 },
             ))
-        };
-        self.probe_at(object.centre, true, Some(&shade))
+        }
     }
 
-    fn probe_at(&self, p: Vec3, with_model: bool, shade: Option<&(dyn Fn(u32, Vec3) -> Vec3 + Sync)>) -> Sh9 {
-        let model = |patch: u32, t: f32, d: Vec3| {
-            if !with_model {
-                return Vec3::ZERO;
-            }
-            let l = self.model.patches[patch as usize].radiance;
-            shade.map_or(l, |f| l * f(patch, p + d * t))
-        };
+    /// The probe at `p` from one set of rays: the model as captured ([`Compositor::irradiance_at`]),
+    /// the sky alone ([`Compositor::sky_irradiance_at`]), and the model times `shade` (the
+    /// object's shadow; the captured model's without one).
+    fn probes_at(&self, p: Vec3, shade: Option<&(dyn Fn(u32, Vec3) -> Vec3 + Sync)>) -> Probes {
         // 2 x 2 rays a texel: a small bright source (the lamp, a third of a texel at 32 x 16)
         // must not hinge on whether a texel centre finds it
         let (w, h) = (64u32, 32u32);
+        const SUB: [(f32, f32); 4] = [(0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)];
         let lights = match &self.probe {
             ObjectProbe::Lights(n) => &self.lights[..(*n).min(self.lights.len())],
             ObjectProbe::Map(_) => &[],
         };
         let in_a_light = |d: Vec3| lights.iter().any(|l| d.dot(l.direction) >= l.cos_half_angle());
         let map = |d: Vec3| self.map.as_ref().map_or(Vec3::ZERO, |m| m.lookup(d));
-        let radiance = |d: Vec3| match (self.bvh.first_hit(p, d), &self.probe) {
-            // the model in place of the map, which the exact projection already holds
-            (Some((patch, t)), ObjectProbe::Map(_)) => model(patch, t, d) - map(d),
-            (Some((patch, t)), _) => model(patch, t, d),
-            (None, ObjectProbe::Map(_)) => Vec3::ZERO,
-            (None, _) if in_a_light(d) => Vec3::ZERO,
-            (None, _) => map(d),
-        };
-        let probe = EnvMap::from_texels(w, h, |i, j| {
-            [(0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)]
-                .iter()
-                .map(|&(du, dv)| {
-                    let uv = glam::Vec2::new((i as f32 + du) / w as f32, (j as f32 + dv) / h as f32);
-                    radiance(envmap_sphere::latlong::latlong_uv_to_dir(uv))
-                })
-                .sum::<Vec3>()
-                / 4.0
-        });
-        let mut sh = match &self.probe {
-            ObjectProbe::Map(map_sh) => signed_projection(&probe, map_sh),
-            ObjectProbe::Lights(_) => Sh9::project(&probe),
-        };
-        for l in lights.iter().filter(|l| self.bvh.escapes(p, l.direction)) {
-            let power = l.radiance * l.solid_angle;
-            for (c, y) in sh.coeffs.iter_mut().zip(envmap_sphere::sh::sh9_basis(l.direction)) {
-                *c += power * y;
+        // per ray: the map's part (what replaces or stands beside the model) and the model's
+        // radiance where it is met, as captured and shaded
+        let rays: Vec<(Vec3, Vec3, Vec3)> = (0..w * h * 4)
+            .into_par_iter()
+            .map(|k| {
+                let (texel, (du, dv)) = (k / 4, SUB[k as usize % 4]);
+                let uv = glam::Vec2::new(((texel % w) as f32 + du) / w as f32, ((texel / w) as f32 + dv) / h as f32);
+                let d = envmap_sphere::latlong::latlong_uv_to_dir(uv);
+                match (self.bvh.first_hit(p, d), &self.probe) {
+                    (Some((patch, t)), probe) => {
+                        let l = self.model.patches[patch as usize].radiance;
+                        let shaded = shade.map_or(l, |f| l * f(patch, p + d * t));
+                        // the model in place of the map, which the exact projection already holds
+                        let base = if matches!(probe, ObjectProbe::Map(_)) { -map(d) } else { Vec3::ZERO };
+                        (base, l, shaded)
+                    }
+                    (None, ObjectProbe::Map(_)) => (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO),
+                    (None, _) if in_a_light(d) => (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO),
+                    (None, _) => (map(d), Vec3::ZERO, Vec3::ZERO),
+                }
+            })
+            .collect();
+        let escaping: Vec<&DistantLight> = lights.iter().filter(|l| self.bvh.escapes(p, l.direction)).collect();
+        let project = |pick: &dyn Fn(&(Vec3, Vec3, Vec3)) -> Vec3| {
+            let probe = EnvMap::from_texels(w, h, |i, j| {
+                let k = 4 * (j * w + i) as usize;
+                rays[k..k + 4].iter().map(pick).sum::<Vec3>() / 4.0
+            });
+            let mut sh = match &self.probe {
+                ObjectProbe::Map(map_sh) => signed_projection(&probe, map_sh),
+                ObjectProbe::Lights(_) => Sh9::project(&probe),
+            };
+            for l in &escaping {
+                let power = l.radiance * l.solid_angle;
+                for (c, y) in sh.coeffs.iter_mut().zip(envmap_sphere::sh::sh9_basis(l.direction)) {
+                    *c += power * y;
+                }
             }
-        }
-        sh
+            sh
+        };
+        let full = project(&|r| r.0 + r.1);
+        Probes { full, sky: project(&|r| r.0), shadowed: if shade.is_some() { project(&|r| r.0 + r.2) } else { full } }
     }
+}
+
+/// [`Compositor::probes_at`]'s three projections of one set of rays.
+struct Probes {
+    full: Sh9,
+    sky: Sh9,
+    shadowed: Sh9,
 }
 
 /// `base` plus the SH9 projection of `signed` (a map of signed radiance differences, which
@@ -534,13 +557,9 @@ fn signed_projection(signed: &EnvMap, base: &Sh9) -> Sh9 {
 }
 
 /// Each pixel's receiver: the centre ray's first patch, its slot and bilinear weights.
-fn pixel_refs(model: &RealScene, prepared: &Prepared, bvh: &dyn Visibility) -> Vec<PixelRef> {
+fn pixel_refs(model: &RealScene, receiver_of: &[u32], bvh: &dyn Visibility) -> Vec<PixelRef> {
     let cam = &model.camera;
     let rays = cam.rays();
-    let mut receiver_of = vec![u32::MAX; model.patches.len()];
-    for (k, &r) in prepared.receivers.iter().enumerate() {
-        receiver_of[r as usize] = k as u32;
-    }
     let mut out = Vec::with_capacity(cam.width as usize * cam.height as usize);
     for y in 0..cam.height {
         for x in 0..cam.width {

@@ -505,6 +505,8 @@ impl GpuCompositor {
             keeps.push([1.0; 4]);
         }
         let keep_buffer = buffer("keeps", bytemuck::cast_slice(&keeps), wgpu::BufferUsages::STORAGE);
+        // the object's bounding radius: a blocker within it of the receiver is at the contact
+        let object_radius = 0.5 * (bounds.max - bounds.min).length();
         encoder.clear_buffer(&self.darkening, 0, None);
         for ((array, mine), &(first, _)) in maps.arrays.iter().zip(&maps.params).zip(&maps.batches) {
             // the dispatch covers the union of the batch's rectangles, no more
@@ -524,10 +526,7 @@ impl GpuCompositor {
                 reps: mine.len() as u32,
                 first_rep: first as u32,
                 origin: [union[0], union[1]],
-                object_radius: {
-                    let b = object.bounds();
-                    0.5 * (b.max - b.min).length()
-                },
+                object_radius,
             };
             let uniform = buffer("mask params", bytemuck::bytes_of(&uniform), wgpu::BufferUsages::UNIFORM);
             let params = buffer("mask maps", bytemuck::cast_slice(mine), wgpu::BufferUsages::STORAGE);

@@ -91,12 +91,13 @@ pub(crate) fn run(args: &CompositeArgs) -> Result<(), String> {
         None => BackdropSession::new(map, camera, &settings).map_err(e)?,
     };
     let c = &session.compositor;
-    if let (Some((g, scale)), Some(photo)) = (&session.photo, &view.photo) {
+    if let (Some(fit), Some(photo)) = (&session.photo, &view.photo) {
         say(&format!(
-            "{}: {w} x {h}, exposure x {scale:.4} to the probe's units; {} pixels clipped, {} raised to the probe's radiance",
+            "{}: {w} x {h}, exposure x {:.4} to the probe's units; {} pixels clipped, {} raised to the probe's radiance",
             args.photo.as_deref().unwrap_or(Path::new("")).display(),
+            fit.exposure,
             photo.clipped_pixels(),
-            g.raised
+            fit.raised
         ));
     }
     say(&format!(
@@ -168,9 +169,9 @@ pub(crate) fn run(args: &CompositeArgs) -> Result<(), String> {
             "eye": (eye + view.shift).to_array(),
             "target": (target + view.shift).to_array(),
             "photo": args.photo.as_ref().map(|p| p.display().to_string()),
-            "photo_exposure": session.photo.as_ref().map(|p| p.1),
+            "photo_exposure": session.photo.map(|p| p.exposure),
             "clipped_pixels": view.photo.as_ref().map(real_scene::Photograph::clipped_pixels),
-            "clipped_raised": session.photo.as_ref().map(|p| p.0.raised),
+            "clipped_raised": session.photo.map(|p| p.raised),
             "passes": main.passes,
             "representatives": main.reps,
             "mode": main.mode_label().to_lowercase(),

@@ -314,20 +314,18 @@ pub struct PhotoGround {
     pub clip: Option<f32>,
     /// Pixels whose clipped channels the probe raised.
     pub raised: usize,
-    /// The gamma of the response the photograph was read through.
-    pub gamma: f32,
 }
 
 impl PhotoGround {
-    /// The ground of `photo` (already in `probe`'s units and at `camera`'s size) seen by
-    /// `camera`, above `backdrop`'s ground.
+    /// The ground of `photo` (at `camera`'s size; times `exposure`, in `probe`'s units) seen
+    /// by `camera`, above `backdrop`'s ground.
     ///
     /// # Errors
     /// [`RealSceneError::Parameter`] when the photograph's size is not the camera's.
     pub fn new(
         backdrop: Backdrop,
         probe: &EnvMap,
-        photo: &crate::Photograph,
+        (photo, exposure): (&crate::Photograph, f32),
         camera: scene::Camera,
     ) -> Result<Self, RealSceneError> {
         if (photo.width, photo.height) != (camera.width, camera.height) {
@@ -342,7 +340,7 @@ impl PhotoGround {
             (0..photo.radiance.len())
                 .into_par_iter()
                 .map(|k| {
-                    let (l, mask) = (photo.radiance[k], photo.clipped[k]);
+                    let (l, mask) = (photo.radiance[k] * exposure, photo.clipped[k]);
                     if mask == 0 {
                         return (l, false);
                     }
@@ -356,7 +354,7 @@ impl PhotoGround {
                 })
                 .unzip();
         let raised = raised.iter().filter(|&&r| r).count();
-        Ok(Self { backdrop, camera, plate, clip: photo.clip, raised, gamma: photo.gamma })
+        Ok(Self { backdrop, camera, plate, clip: photo.clip.map(|c| c * exposure), raised })
     }
 
     /// The radiance of ground point `p`: the plate's (bilinear) where the camera sees it, the

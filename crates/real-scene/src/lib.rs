@@ -165,6 +165,9 @@ pub enum RealSceneError {
     /// A parameter out of its range (a backdrop's height or radius, a camera below the ground).
     #[error("{0}")]
     Parameter(String),
+    /// An HDR photograph the maps' reader refuses: its message, which names the file.
+    #[error("{0}")]
+    Image(String),
     /// A photograph that cannot be read or used, and why.
     #[error("{path}: {reason}", path = path.display())]
     Photo {

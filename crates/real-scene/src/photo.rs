@@ -99,11 +99,8 @@ impl Photograph {
     /// [`RealSceneError::Photo`] naming the file: unreadable, another format, too large,
     /// undecodable, not finite or negative.
     pub fn open(path: &std::path::Path, gamma: f32) -> Result<Self, RealSceneError> {
-        let fail = |reason: String| RealSceneError::Photo { path: path.to_path_buf(), reason };
-        if !(gamma.is_finite() && (0.1..=10.0).contains(&gamma)) {
-            return Err(fail(format!("a response gamma of {gamma} (0.1 to 10)")));
-        }
-        let bytes = std::fs::read(path).map_err(|e| fail(e.to_string()))?;
+        let bytes = std::fs::read(path)
+            .map_err(|e| RealSceneError::Photo { path: path.to_path_buf(), reason: e.to_string() })?;
         Self::from_bytes(&bytes, path, gamma, MAX_PHOTO_PIXELS)
     }
 
@@ -123,17 +120,16 @@ impl Photograph {
             return Err(fail(format!("a response gamma of {gamma} (0.1 to 10)")));
         }
         let max_pixels = max_pixels.min(MAX_PHOTO_PIXELS);
-        if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) || bytes.starts_with(b"#?") {
-            let image = envmap_sphere::load_rgb_image_from_bytes(
-                bytes,
-                path,
-                &envmap_sphere::LoadOptions { max_pixels, ..envmap_sphere::LoadOptions::default() },
-            )
-            .map_err(|e| fail(one_line(&e).replace(&format!("{}: ", path.display()), "")))?;
-            if image.pixels.iter().any(|p| p.min_element() < 0.0) {
+        // an HDR image through the maps' own reader; anything it does not know as one, an
+        // integer image
+        let options = envmap_sphere::LoadOptions { max_pixels, ..envmap_sphere::LoadOptions::default() };
+        match envmap_sphere::load_rgb_image_from_bytes(bytes, path, &options) {
+            Ok(image) if image.pixels.iter().any(|p| p.min_element() < 0.0) => {
                 return Err(fail("negative radiance: not a photograph".into()));
             }
-            return Ok(Self::from_hdr(image.width, image.height, image.pixels));
+            Ok(image) => return Ok(Self::from_hdr(image.width, image.height, image.pixels)),
+            Err(envmap_sphere::EnvMapError::UnknownFormat { .. }) => {}
+            Err(e) => return Err(RealSceneError::Image(e.to_string())),
         }
         let guess = || {
             image::ImageReader::new(std::io::Cursor::new(bytes))
@@ -262,9 +258,9 @@ fn check_size(w: u32, h: u32, max_pixels: u64) -> Result<(), String> {
     Ok(())
 }
 
-/// A decoder's message on one line: control characters (from the file) become spaces.
+/// A decoder's message on one line (control characters from the file escaped).
 fn one_line(e: &impl std::fmt::Display) -> String {
-    e.to_string().chars().map(|c| if c.is_control() { ' ' } else { c }).collect()
+    envmap_sphere::error::one_line(&e.to_string())
 }
 
 #[cfg(test)]

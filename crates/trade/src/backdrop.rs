@@ -135,9 +135,17 @@ pub struct BackdropSession {
     pub ground: (scene::Object, scene::Texture),
     /// Extracted lights and residual cones among the sources.
     pub lights: (usize, usize),
-    /// In photograph mode: the photograph's ground, and the scale that brought the photograph
-    /// to the probe's units.
-    pub photo: Option<(PhotoGround, f32)>,
+    /// In photograph mode, how the photograph was fitted to the probe.
+    pub photo: Option<PhotoFit>,
+}
+
+/// How a photograph was fitted to its probe ([`BackdropSession::with_photo`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PhotoFit {
+    /// The scale that brought the photograph to the probe's units.
+    pub exposure: f32,
+    /// Pixels whose clipped channels the probe raised ([`PhotoGround`]).
+    pub raised: usize,
 }
 
 impl BackdropSession {
@@ -148,6 +156,7 @@ impl BackdropSession {
     /// A camera below the ground or not a view, a size of 0 or over 8192, an extraction or a
     /// hierarchy that fails.
     pub fn new(map: EnvMap, camera: scene::Camera, settings: &BackdropSettings) -> Result<Self, CompositeError> {
+        check_view(&camera)?;
         Self::build(map, camera, settings, None)
     }
 
@@ -175,46 +184,28 @@ impl BackdropSession {
                     .into(),
             )
         })?;
-        let ground = PhotoGround::new(backdrop, &probe, &photo.clone().scaled(scale), camera)?;
-        Self::build(probe, camera, settings, Some((ground, scale)))
+        let ground = PhotoGround::new(backdrop, &probe, (photo, scale), camera)?;
+        Self::build(probe, camera, settings, Some((ground, scale, photo.gamma)))
     }
 
+    /// The session, its camera checked; `photo` is a photograph's ground, its exposure and its
+    /// response's gamma.
     fn build(
         map: EnvMap,
         camera: scene::Camera,
         settings: &BackdropSettings,
-        photo: Option<(PhotoGround, f32)>,
+        photo: Option<(PhotoGround, f32, f32)>,
     ) -> Result<Self, CompositeError> {
-        check_view(&camera)?;
         let (w, h) = (camera.width, camera.height);
         let backdrop = settings.backdrop;
         let (lights, main, mut direct) = sources(&map, settings.lights, settings.residual_lights)?;
         let e = Backdrop::ground_irradiance(&map);
         let radiance = |p: Vec3| match &photo {
-            Some((g, _)) => g.radiance(&map, p),
+            Some((g, ..)) => g.radiance(&map, p),
             None => backdrop.ground_radiance(&map, p),
         };
         let model = backdrop.real_scene_from(&radiance, e, &camera);
-        let (plate, response, clip) = match &photo {
-            Some((g, _)) => {
-                let gamma = g.gamma;
-                let response = match g.clip {
-                    // the photograph's own clip is the response's white
-                    Some(c) if c > 0.0 => CameraResponse { exposure: 1.0 / c, gamma, white: 1.0 },
-                    _ => CameraResponse { gamma, ..CameraResponse::auto(&g.plate) },
-                };
-                (g.plate.clone(), response, g.clip)
-            }
-            None => {
-                let plate = backdrop.plate(&map, &camera, settings.plate_samples);
-                let response = CameraResponse::auto(&plate);
-                (plate, response, None)
-            }
-        };
-        let bvh = SceneBvh::new(&model.to_scene());
-        let built = build(&model, &lights, &bvh, &settings.preprocess)?;
-        // the compositor's own ray queries: the BVH the pre-process used
-        let rays = Box::new(bvh);
+        let ground = backdrop.ground_from(&radiance, e, settings.ground_texels);
         // each receiver pixel's own reflectance: the ground point its centre ray meets (the
         // photograph's pixel itself in photograph mode)
         let camera_rays = camera.rays();
@@ -222,11 +213,30 @@ impl BackdropSession {
             .map(|k| {
                 let (o, d) = camera_rays.ray((k % w) as f32 + 0.5, (k / w) as f32 + 0.5);
                 backdrop.ground_hit(o, d).map_or(Vec3::ZERO, |p| match &photo {
-                    Some((g, _)) => Backdrop::reflectance(g.plate[k as usize], e),
+                    Some((g, ..)) => Backdrop::reflectance(g.plate[k as usize], e),
                     None => Backdrop::reflectance(backdrop.ground_radiance(&map, p), e),
                 })
             })
             .collect();
+        let (plate, response, clip, fit) = match photo {
+            Some((g, exposure, gamma)) => {
+                let response = match g.clip {
+                    // the photograph's own clip is the response's white
+                    Some(c) if c > 0.0 => CameraResponse { exposure: 1.0 / c, gamma, white: 1.0 },
+                    _ => CameraResponse { gamma, ..CameraResponse::auto(&g.plate) },
+                };
+                (g.plate, response, g.clip, Some(PhotoFit { exposure, raised: g.raised }))
+            }
+            None => {
+                let plate = backdrop.plate(&map, &camera, settings.plate_samples);
+                let response = CameraResponse::auto(&plate);
+                (plate, response, None, None)
+            }
+        };
+        let bvh = SceneBvh::new(&model.to_scene());
+        let built = build(&model, &lights, &bvh, &settings.preprocess)?;
+        // the compositor's own ray queries: the BVH the pre-process used
+        let rays = Box::new(bvh);
         let mut compositor = Compositor::new(model, lights, Some(map.clone()), built, plate, response, rays)?
             .with_pixel_reflectance(&per_pixel)?;
         compositor.clip = clip;
@@ -244,8 +254,7 @@ impl BackdropSession {
         compositor.object_replaces_sources = true;
         compositor.object_shadows_probe = true;
         let residual = compositor.lights.len() - main;
-        let ground = backdrop.ground_from(&radiance, e, settings.ground_texels);
-        Ok(Self { map, backdrop, compositor, ground, lights: (main, residual), photo })
+        Ok(Self { map, backdrop, compositor, ground, lights: (main, residual), photo: fit })
     }
 
     /// The local scene path traced with `object` and without it, `spp` samples a pixel each

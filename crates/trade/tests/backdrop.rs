@@ -276,7 +276,7 @@ fn a_photograph_of_the_backdrop_composites_as_the_backdrop() {
     let photo = real_scene::Photograph::from_hdr(SIZE.0, SIZE.1, s.compositor.photo_hdr.clone()).scaled(0.25);
     assert_eq!(photo.clip, None, "a rendered plate does not clip");
     let p = BackdropSession::with_photo(map(sun_behind()), &photo, cam, &settings(20.0)).unwrap();
-    let scale = p.photo.as_ref().unwrap().1;
+    let scale = p.photo.unwrap().exposure;
     assert!((scale - 4.0).abs() < 4e-3, "exposure x {scale}, not 4");
     let (a, b) = (composite(&s, &object, true).1, composite(&p, &object, true).1);
     let c = &s.compositor;
@@ -331,7 +331,7 @@ fn an_hdr_photo_with_clipped_pixels_keeps_its_shadow() {
         (rmse(&hdr), hdr)
     };
     let p = BackdropSession::with_photo(striped_map(sun_behind(), 0.25), &photo, cam, &settings(20.0)).unwrap();
-    assert!(p.photo.as_ref().unwrap().0.raised > 100, "the probe raised the clipped ground");
+    assert!(p.photo.unwrap().raised > 100, "the probe raised the clipped ground");
     let (ours, hdr) = error(&p);
     // the ground only darkens: no raised pixel shows through brighter than the photograph
     assert!(hdr.iter().all(|v| v.max_element() <= clip), "the composite clips where the camera did");
