@@ -1,10 +1,11 @@
 //! `cargo xtask test`: the whole test suite, as CI runs it.
 //!
 //! Unit, integration and doc tests of every crate (the GPU ones on the best adapter present, or
-//! the one `--adapter` names; lavapipe where there is no GPU), one smoke run of every criterion
-//! bench (so benches never rot), and — when no test filter is given — the main job, `cargo xtask
-//! validate` with its defaults and thresholds, checking that docs/measured.md's validate figures
-//! are this code's. Prints the wall time.
+//! the one `--adapter` names; lavapipe where there is no GPU) and one smoke run of every
+//! criterion bench (so benches never rot). The main job is among the tests: `cargo xtask
+//! validate --quick` from a copied binary, with its thresholds, checking that docs/measured.md's
+//! quick validate figures are this code's (xtask's `cli` test; the full run took 650-800 s of a
+//! 2-core machine, which CI's 30 minutes cannot hold beside the tests). Prints the wall time.
 
 use std::process::Command;
 use std::time::Instant;
@@ -31,15 +32,6 @@ pub fn run(adapter: Option<&str>, extra: &[String]) -> Result<(), String> {
         if !status.success() {
             return Err(format!("cargo {} failed ({status})", args.join(" ")));
         }
-    }
-    if extra.is_empty() {
-        // the main job with its defaults, as a user runs it, and docs/measured.md's figures with it
-        let readme = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/measured.md");
-        let readme = readme.to_string_lossy();
-        outln!("xtask test: cargo xtask validate --check-readme {readme}");
-        let mut validate = vec!["validate", "--check-readme", &readme];
-        validate.extend(adapter.map(|a| ["--adapter", a]).into_iter().flatten());
-        crate::validate::run(&clap::Parser::parse_from(validate))?;
     }
     outln!("xtask test: all passed in {:.0} s", start.elapsed().as_secs_f64());
     Ok(())

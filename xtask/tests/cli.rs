@@ -38,16 +38,23 @@ fn bad_input_exits_one_with_one_line_naming_the_file() {
 }
 
 #[test]
-fn validate_quick_runs_from_a_copied_binary_and_meets_its_thresholds() {
-    // a binary copied elsewhere, run from an empty folder: the thresholds are in the binary
+fn validate_quick_runs_from_a_copied_binary_meets_its_thresholds_and_the_docs_figures() {
+    // a binary copied elsewhere, run from an empty folder: the thresholds are in the binary;
+    // docs/measured.md's quick block must be what this code measures (CI's validate run)
     let dir = fresh_dir("cli-validate");
     let copy = dir.join("xtask-copy");
     std::fs::copy(env!("CARGO_BIN_EXE_xtask"), &copy).expect("copy the binary");
-    let out =
-        Command::new(&copy).args(["validate", "--quick", "--out", "out"]).current_dir(&dir).output().expect("run");
+    let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/measured.md");
+    let out = Command::new(&copy)
+        .args(["validate", "--quick", "--out", "out", "--check-readme"])
+        .arg(&docs)
+        .current_dir(&dir)
+        .output()
+        .expect("run");
     let dir = dir.join("out");
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{text}\n{}", String::from_utf8_lossy(&out.stderr));
+    assert!(text.contains("validate --quick figures match this run"), "{text}");
     assert!(text.contains("[1/10] load environment map") && text.contains("[10/10] report"), "{text}");
     // the adapter is named before any work, and again by the GPU stage
     let first = text.lines().next().unwrap_or_default();

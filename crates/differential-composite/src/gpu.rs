@@ -108,10 +108,14 @@ pub struct MapWork {
     pub hemispheres_skipped: u32,
 }
 
-/// Where a GPU frame's time went (wall clock on the CPU, each stage waited for).
+/// Where a GPU frame's time went: the CPU's work, then each GPU stage between timestamps of
+/// its own (the frame recorded into one submission, as [`GpuCompositor::record`] records it),
+/// or, without timestamps inside encoders, each stage submitted and waited for on the wall
+/// clock.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct FrameTimes {
-    /// Traversal, representative set, transfers and the object's irradiance probe (CPU).
+    /// Traversal, representative set, transfers and the object's irradiance probe, and the
+    /// recording of the GPU's commands (CPU).
     pub cpu: Duration,
     /// The G-buffer of the reconstruction with the object.
     pub gbuffer: Duration,
@@ -119,8 +123,10 @@ pub struct FrameTimes {
     pub shadow_maps: Duration,
     /// Their masks and the darkening.
     pub masks: Duration,
-    /// The resolve and the readback of the 8-bit image.
+    /// The resolve into the output (on the wall clock, with the 8-bit image's readback).
     pub resolve: Duration,
+    /// Which clock timed the GPU's stages.
+    pub clock: gpu::Clock,
 }
 
 impl FrameTimes {
@@ -269,9 +275,11 @@ impl GpuCompositor {
     }
 
     /// Composites `frame` (made by `c.frame`) for `object` in `mode`: the 8-bit image, where
-    /// the time went (`cpu` is `frame`'s own) and the shadow maps' views. The measured form of
-    /// [`GpuCompositor::record`]: the same stages, each in a submission of its own, waited for
-    /// and timed, then the image read back.
+    /// the time went (`cpu` is `frame`'s own and the recording's) and the shadow maps' views.
+    /// The measured form of [`GpuCompositor::record`]: the same recording, one submission with
+    /// a GPU timestamp between stages, waited for, then the image read back (not timed). Without
+    /// timestamps inside encoders each stage is a submission of its own, waited for and timed
+    /// on the wall clock, the readback in the resolve's time.
     ///
     /// # Errors
     /// GPU failures.
@@ -285,6 +293,27 @@ impl GpuCompositor {
         settings: &GpuSettings,
     ) -> Result<(Vec<[u8; 3]>, FrameTimes, MapWork), GpuError> {
         let mut times = FrameTimes { cpu: frame.cpu(), ..FrameTimes::default() };
+        if let Some(stamps) = gpu::StageStamps::new(gpu, 4)? {
+            let t = Instant::now();
+            let mut encoder = gpu.encoder("composite, timed");
+            stamps.write(&mut encoder, 0);
+            let gb = self.record_gbuffer(gpu, &mut encoder, c, object, settings)?;
+            stamps.write(&mut encoder, 1);
+            let maps = self.record_maps(gpu, &mut encoder, c, frame, object, settings)?;
+            stamps.write(&mut encoder, 2);
+            self.record_masks(gpu, &mut encoder, (c, frame, object), mode, settings, &maps);
+            stamps.write(&mut encoder, 3);
+            self.record_resolve(gpu, &mut encoder, c, &gb, frame, object, mode);
+            stamps.write(&mut encoder, 4);
+            stamps.record_resolve(&mut encoder);
+            times.cpu += t.elapsed();
+            gpu.submit_and_wait(encoder)?;
+            if let [g, m, k, r] = stamps.read(gpu)?[..] {
+                (times.gbuffer, times.shadow_maps, times.masks, times.resolve) = (g, m, k, r);
+            }
+            times.clock = gpu::Clock::GpuTimestamps;
+            return Ok((self.read_output(gpu)?, times, maps.work));
+        }
         let stage = |label, record: &mut dyn FnMut(&mut wgpu::CommandEncoder) -> Result<(), GpuError>| {
             let t = Instant::now();
             let mut encoder = gpu.encoder(label);

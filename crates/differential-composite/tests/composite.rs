@@ -333,7 +333,7 @@ fn hemispherical_sources_render_one_paraboloid_view_and_cubes_six() {
 #[test]
 fn the_composite_recorded_into_one_encoder_equals_the_measured_one() {
     // the real-time path: every stage recorded into the caller's encoder, nothing submitted,
-    // waited for or read back while recording; the measured path waits after each stage
+    // waited for or read back while recording; the measured path is the same recording timed
     let s = room();
     let c = &s.compositor;
     let (g, gc) = gpu();
@@ -342,7 +342,21 @@ fn the_composite_recorded_into_one_encoder_equals_the_measured_one() {
         let frame = c.frame(&object, 20);
         for mode in [Mode::Hdr, Mode::Ldr] {
             let settings = GpuSettings::default();
-            let (measured, _, work) = gc.composite(g, c, &frame, &object, mode, &settings).unwrap();
+            let before = g.counters();
+            let wall = std::time::Instant::now();
+            let (measured, times, work) = gc.composite(g, c, &frame, &object, mode, &settings).unwrap();
+            let (wall, measuring) = (wall.elapsed(), g.counters() - before);
+            // with timestamps inside encoders the measured frame is the recorded one: one
+            // submission (and the image's readback), its stages between timestamps within the
+            // call's wall time; without them each of the four stages is a submission waited for
+            let stamped =
+                g.features.contains(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS);
+            let want = if stamped { (gpu::Clock::GpuTimestamps, 2) } else { (gpu::Clock::WallTime, 5) };
+            assert_eq!((times.clock, measuring.submits), want, "{at} {mode:?}");
+            assert!(
+                times.total() - times.cpu <= wall && times.masks > std::time::Duration::ZERO,
+                "{times:?} in {wall:?}"
+            );
             let mut encoder = g.encoder("composite");
             let before = g.counters();
             let recorded_work = gc.record(g, &mut encoder, c, &frame, &object, mode, &settings).unwrap();

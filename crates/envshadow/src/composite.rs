@@ -287,6 +287,17 @@ pub(crate) fn run(args: &CompositeArgs) -> Result<(), String> {
             "estimate_reflectances": args.estimate_reflectances,
             "prune": args.prune.unwrap_or(0.02),
             "adapter": gpu.info.name,
+            "rows": table.iter().map(|r| {
+                let mut o = r.times_json();
+                o.extend([
+                    ("passes".to_string(), serde_json::json!(r.passes)),
+                    ("mode".to_string(), serde_json::json!(r.mode_label().to_lowercase())),
+                    ("representatives".to_string(), serde_json::json!(r.reps)),
+                    ("error_mae_codes".to_string(), serde_json::json!(r.error.mae_changed)),
+                    ("error_rmse_codes".to_string(), serde_json::json!(r.error.rmse_changed)),
+                ]);
+                o
+            }).collect::<Vec<_>>(),
         });
         print_json(v, main);
         return Ok(());

@@ -497,6 +497,8 @@ fn composite_onto_a_map_has_the_interface_keys_and_refuses_bad_input() {
     assert!(v["sources_excluded"].is_u64() && v["adapter"].as_str().is_some_and(|a| !a.is_empty()), "{v}");
     assert!(v["changed_pixels"].as_u64().unwrap_or(0) > 20, "the cube changes the image: {v}");
     assert!(v["sources_excluded"].as_u64() <= v["sources"].as_u64(), "{v}");
+    // the GPU's stages timed as the issue asks where the adapter can (lavapipe can)
+    assert!(["GPU timestamps", "wall time (submit + wait)"].contains(&v["clock"].as_str().unwrap_or_default()), "{v}");
     // the camera looks at the cube from the map's centre of projection, 1.6 m up
     let eye: Vec<f64> =
         v["eye"].as_array().map(|a| a.iter().filter_map(serde_json::Value::as_f64).collect()).unwrap_or_default();

@@ -139,6 +139,6 @@ pub use technique::{
     LightShape, LightStamps, PrecomputedVisibility, Receivers, ShadowPassReport, ShadowTechnique, WEBER_FRACTION,
     WEBER_MAX_RECEIVERS, culled_totals, record_visibility, render_visibility, skip_reasons, totals, weber_negligible,
 };
-pub use timer::Clock;
+pub use timer::{Clock, StageStamps};
 pub use upsample::{JointBilateral, UpsamplePass};
 pub use view::{View, conservative_bounds};

@@ -276,9 +276,7 @@ pub(crate) fn record_visibility_stamped(
 /// Two GPU timestamps a light around its recorded passes: how measurement times each light of
 /// a frame recorded into one submission. Made per measured frame (measurement only).
 pub struct LightStamps {
-    set: wgpu::QuerySet,
-    resolve: wgpu::Buffer,
-    read: wgpu::Buffer,
+    stamps: crate::timer::Stamps,
     lights: usize,
 }
 
@@ -288,69 +286,36 @@ impl LightStamps {
     /// # Errors
     /// [`GpuError::TooLarge`] past the queries one set holds.
     pub fn new(gpu: &Gpu, lights: usize) -> Result<Option<Self>, GpuError> {
-        let timestamps = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
-        if !gpu.features.contains(timestamps) || lights == 0 {
-            return Ok(None);
-        }
-        let queries = 2 * lights as u64;
-        if queries > u64::from(wgpu::QUERY_SET_MAX_QUERIES) {
-            return Err(GpuError::TooLarge {
-                what: "lights timed in one submission",
-                size: lights as u64,
-                limit: u64::from(wgpu::QUERY_SET_MAX_QUERIES / 2),
-            });
-        }
-        let set = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
-            label: Some("per-light timestamps"),
-            ty: wgpu::QueryType::Timestamp,
-            count: queries as u32,
-        });
-        let buffer = |label, usage| {
-            gpu.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: 8 * queries,
-                usage,
-                mapped_at_creation: false,
-            })
-        };
-        Ok(Some(Self {
-            set,
-            resolve: buffer("per-light timestamps", wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC),
-            read: buffer("per-light timestamps read", wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST),
-            lights,
-        }))
+        let stamps = crate::timer::Stamps::new(gpu, lights as u64, 2, "lights timed in one submission")?;
+        Ok(stamps.map(|stamps| Self { stamps, lights }))
     }
 
     fn write(&self, encoder: &mut wgpu::CommandEncoder, light: usize, end: u32) {
         if light < self.lights {
-            encoder.write_timestamp(&self.set, 2 * light as u32 + end);
+            self.stamps.write(encoder, 2 * light as u32 + end);
         }
     }
 
     /// Records the stamps' resolve and copy, after every light's passes.
     pub fn record_resolve(&self, encoder: &mut wgpu::CommandEncoder) {
-        let queries = 2 * self.lights as u32;
-        encoder.resolve_query_set(&self.set, 0..queries, &self.resolve, 0);
-        encoder.copy_buffer_to_buffer(&self.resolve, 0, &self.read, 0, 8 * u64::from(queries));
+        self.stamps.record_resolve(encoder);
     }
 
     /// The buffer the stamps are mapped from, once their submission has run.
     #[must_use]
     pub fn read_buffer(&self) -> &wgpu::Buffer {
-        &self.read
+        self.stamps.read_buffer()
     }
 
     /// Puts each drawn light's time (between its two stamps, from the mapped `bytes`) into its
     /// report, `reports[k]` being light k's.
     pub fn apply(&self, gpu: &Gpu, bytes: &[u8], reports: &mut [ShadowPassReport]) {
         let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(bytes);
-        let period = f64::from(gpu.queue.get_timestamp_period());
         for (k, r) in reports.iter_mut().enumerate().take(self.lights) {
             if r.skipped.is_some() || ticks.len() < 2 * k + 2 {
                 continue;
             }
-            let ns = ticks[2 * k + 1].saturating_sub(ticks[2 * k]) as f64 * period;
-            r.time = Duration::from_nanos(ns as u64);
+            r.time = crate::timer::between(gpu, ticks[2 * k], ticks[2 * k + 1]);
             r.clock = Some(Clock::GpuTimestamps);
         }
     }

@@ -5,11 +5,12 @@ use crate::context::{Gpu, GpuError};
 use std::time::Duration;
 
 /// Which clock a duration came from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Clock {
     /// GPU timestamp queries around the commands.
     GpuTimestamps,
     /// Wall time of submit and wait on the CPU.
+    #[default]
     WallTime,
     /// Wall time of one submission holding several lights, an even share each: without
     /// timestamps inside encoders the lights recorded together cannot be told apart (their
@@ -69,5 +70,111 @@ impl Gpu {
         let ticks: [u64; 2] = bytemuck::pod_read_unaligned(&bytes[..16]);
         let ns = ticks[1].saturating_sub(ticks[0]) as f64 * f64::from(self.queue.get_timestamp_period());
         Ok((Duration::from_nanos(ns as u64), Clock::GpuTimestamps))
+    }
+}
+
+/// A set of GPU timestamps written inside encoders, resolved and copied for mapping: what
+/// [`StageStamps`] and `technique::LightStamps` are made of.
+pub(crate) struct Stamps {
+    set: wgpu::QuerySet,
+    resolve: wgpu::Buffer,
+    read: wgpu::Buffer,
+    pub(crate) count: u32,
+}
+
+impl Stamps {
+    /// `count` stamps; `None` without timestamps inside encoders or for none.
+    ///
+    /// # Errors
+    /// [`GpuError::TooLarge`] past the queries one set holds (`what` and `units` of `per` stamps
+    /// name the request).
+    pub(crate) fn new(gpu: &Gpu, units: u64, per: u64, what: &'static str) -> Result<Option<Self>, GpuError> {
+        let timestamps = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+        let count = units * per + u64::from(per == 1);
+        if !gpu.features.contains(timestamps) || units == 0 {
+            return Ok(None);
+        }
+        if count > u64::from(wgpu::QUERY_SET_MAX_QUERIES) {
+            let limit = (u64::from(wgpu::QUERY_SET_MAX_QUERIES) - u64::from(per == 1)) / per;
+            return Err(GpuError::TooLarge { what, size: units, limit });
+        }
+        let set = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
+            label: Some(what),
+            ty: wgpu::QueryType::Timestamp,
+            count: count as u32,
+        });
+        let buffer = |usage| {
+            gpu.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(what),
+                size: 8 * count,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        Ok(Some(Self {
+            set,
+            resolve: buffer(wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC),
+            read: buffer(wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST),
+            count: count as u32,
+        }))
+    }
+
+    /// Writes stamp `k`; past the last, nothing.
+    pub(crate) fn write(&self, encoder: &mut wgpu::CommandEncoder, k: u32) {
+        if k < self.count {
+            encoder.write_timestamp(&self.set, k);
+        }
+    }
+
+    /// Records the stamps' resolve and copy, after the last.
+    pub(crate) fn record_resolve(&self, encoder: &mut wgpu::CommandEncoder) {
+        encoder.resolve_query_set(&self.set, 0..self.count, &self.resolve, 0);
+        encoder.copy_buffer_to_buffer(&self.resolve, 0, &self.read, 0, 8 * u64::from(self.count));
+    }
+
+    /// The buffer the stamps are mapped from, once their submission has run.
+    pub(crate) fn read_buffer(&self) -> &wgpu::Buffer {
+        &self.read
+    }
+}
+
+/// The time between two ticks of a mapped stamp buffer.
+pub(crate) fn between(gpu: &Gpu, from: u64, to: u64) -> Duration {
+    Duration::from_nanos((to.saturating_sub(from) as f64 * f64::from(gpu.queue.get_timestamp_period())) as u64)
+}
+
+/// GPU timestamps between the stages of one recorded submission: `stages + 1` stamps, stage k
+/// running from stamp k to stamp k + 1. How measurement times a frame recorded as a renderer
+/// records it (one encoder, no waits between stages). Made per measured frame.
+pub struct StageStamps(Stamps);
+
+impl StageStamps {
+    /// Stamps around `stages` stages; `None` without timestamps inside encoders (the caller
+    /// then times each stage on the wall clock) or for no stage.
+    ///
+    /// # Errors
+    /// [`GpuError::TooLarge`] past the queries one set holds.
+    pub fn new(gpu: &Gpu, stages: usize) -> Result<Option<Self>, GpuError> {
+        Ok(Stamps::new(gpu, stages as u64, 1, "stages timed in one submission")?.map(Self))
+    }
+
+    /// Writes stamp `k` (0: before the first stage; k: after stage k - 1); past the last, nothing.
+    pub fn write(&self, encoder: &mut wgpu::CommandEncoder, k: u32) {
+        self.0.write(encoder, k);
+    }
+
+    /// Records the stamps' resolve and copy, after the last stage.
+    pub fn record_resolve(&self, encoder: &mut wgpu::CommandEncoder) {
+        self.0.record_resolve(encoder);
+    }
+
+    /// Each stage's time, once the submission holding the stamps has run: a wait.
+    ///
+    /// # Errors
+    /// GPU failures.
+    pub fn read(&self, gpu: &Gpu) -> Result<Vec<Duration>, GpuError> {
+        let bytes = crate::readback::read_mapped(gpu, self.0.read_buffer())?;
+        let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&bytes);
+        Ok(ticks.windows(2).map(|t| between(gpu, t[0], t[1])).collect())
     }
 }

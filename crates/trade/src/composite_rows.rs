@@ -47,12 +47,12 @@ impl Row {
         if self.mode == Mode::Ldr { "LDR" } else { "HDR" }
     }
 
-    /// The frame's times as the commands' JSON gives them: `ms_per_frame` and each stage's
-    /// `ms_*`.
+    /// The frame's times as the commands' JSON gives them: `ms_per_frame`, each stage's
+    /// `ms_*`, and the `clock` that timed the GPU's stages.
     #[must_use]
     pub fn times_json(&self) -> serde_json::Map<String, serde_json::Value> {
         let [total, cpu, gbuffer, maps, masks, resolve] = self.times_ms();
-        [
+        let mut out: serde_json::Map<String, serde_json::Value> = [
             ("ms_per_frame", total),
             ("ms_cpu", cpu),
             ("ms_gbuffer", gbuffer),
@@ -62,7 +62,9 @@ impl Row {
         ]
         .into_iter()
         .map(|(k, v)| (k.to_string(), serde_json::json!(v)))
-        .collect()
+        .collect();
+        out.insert("clock".into(), self.times.clock.name().into());
+        out
     }
 
     /// The frame's times in milliseconds: total, CPU, G-buffer, maps, masks, resolve.

@@ -95,14 +95,15 @@ impl Compositing {
         let mut s = String::new();
         let _ = write!(
             s,
-            "<h2>Compositing (paper 003): a sphere into <code>ar_ground</code>'s photograph</h2><p>{}x{}, photograph, truth and Debevec's renders path traced at {} spp; the sphere at {:?} m from the floor's centre. Errors in 8-bit codes against the truth (the real scene path traced with the sphere) over the {} pixels the sphere changed. Debevec's offline differential rendering with the same model: MAE {:.2}, RMSE {:.2}. Times: wall clock per frame on this adapter, the median of 3.</p>",
+            "<h2>Compositing (paper 003): a sphere into <code>ar_ground</code>'s photograph</h2><p>{}x{}, photograph, truth and Debevec's renders path traced at {} spp; the sphere at {:?} m from the floor's centre. Errors in 8-bit codes against the truth (the real scene path traced with the sphere) over the {} pixels the sphere changed. Debevec's offline differential rendering with the same model: MAE {:.2}, RMSE {:.2}. Times per frame on this adapter, the median of 3: the CPU's work and recording, then each GPU stage by {}.</p>",
             self.size.0,
             self.size.1,
             self.spp,
             AT.to_array(),
             self.debevec_error.changed,
             self.debevec_error.mae_changed,
-            self.debevec_error.rmse_changed
+            self.debevec_error.rmse_changed,
+            self.rows.first().map_or("—", |r| r.times.clock.name())
         );
         s.push_str("<table><tr><th>passes</th><th>representatives</th><th>mode</th><th>MAE (codes)</th><th>RMSE (codes)</th><th>MAE / Debevec's</th><th>ms per frame</th><th>CPU</th><th>G-buffer</th><th>maps</th><th>masks</th><th>resolve</th></tr>");
         for r in &self.rows {

@@ -427,6 +427,7 @@ pub fn run(args: &ValidateArgs) -> Result<(), String> {
         rows: &rows,
         masks: &mask_rows,
         clock: clock.name(),
+        quick: args.quick,
     };
     if let Some(p) = &args.readme {
         readme::write(p, &figures)?;
