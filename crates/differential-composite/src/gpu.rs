@@ -8,11 +8,12 @@
 //! resolve: the object shaded by its SH9 irradiance, the rest the photograph less the darkening
 //! (HDR: in radiance, then the camera response; LDR: in codes). `GpuCompositor::record` records
 //! the whole frame into the caller's encoder (no submission, wait or readback);
-//! `GpuCompositor::composite` measures the same stages, each waited for.
+//! `GpuCompositor::record_staged` is the same recording with a hook between stages, which
+//! measurement (`trade::composite_rows::composite`) times; nothing here waits.
 //!
 //! Shaders: `crates/differential-composite/shaders/`.
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use glam::Vec3;
 use gpu::{GBuffer, GBufferPass, Gpu, GpuError, SceneGeometry, ShadowGeometry};
@@ -111,7 +112,7 @@ pub struct MapWork {
 /// Where a GPU frame's time went: the CPU's work, then each GPU stage between timestamps of
 /// its own (the frame recorded into one submission, as [`GpuCompositor::record`] records it),
 /// or, without timestamps inside encoders, each stage submitted and waited for on the wall
-/// clock.
+/// clock (`trade::composite_rows::composite` measures it).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct FrameTimes {
     /// Traversal, representative set, transfers and the object's irradiance probe, and the
@@ -123,7 +124,7 @@ pub struct FrameTimes {
     pub shadow_maps: Duration,
     /// Their masks and the darkening.
     pub masks: Duration,
-    /// The resolve into the output (on the wall clock, with the 8-bit image's readback).
+    /// The resolve into the output.
     pub resolve: Duration,
     /// Which clock timed the GPU's stages.
     pub clock: gpu::Clock,
@@ -274,78 +275,6 @@ impl GpuCompositor {
         })
     }
 
-    /// Composites `frame` (made by `c.frame`) for `object` in `mode`: the 8-bit image, where
-    /// the time went (`cpu` is `frame`'s own and the recording's) and the shadow maps' views.
-    /// The measured form of [`GpuCompositor::record`]: the same recording, one submission with
-    /// a GPU timestamp between stages, waited for, then the image read back (not timed). Without
-    /// timestamps inside encoders each stage is a submission of its own, waited for and timed
-    /// on the wall clock, the readback in the resolve's time.
-    ///
-    /// # Errors
-    /// GPU failures.
-    pub fn composite(
-        &self,
-        gpu: &Gpu,
-        c: &Compositor,
-        frame: &FrameTransfers,
-        object: &SyntheticObject,
-        mode: Mode,
-        settings: &GpuSettings,
-    ) -> Result<(Vec<[u8; 3]>, FrameTimes, MapWork), GpuError> {
-        let mut times = FrameTimes { cpu: frame.cpu(), ..FrameTimes::default() };
-        if let Some(stamps) = gpu::StageStamps::new(gpu, 4)? {
-            let t = Instant::now();
-            let mut encoder = gpu.encoder("composite, timed");
-            stamps.write(&mut encoder, 0);
-            let gb = self.record_gbuffer(gpu, &mut encoder, c, object, settings)?;
-            stamps.write(&mut encoder, 1);
-            let maps = self.record_maps(gpu, &mut encoder, c, frame, object, settings)?;
-            stamps.write(&mut encoder, 2);
-            self.record_masks(gpu, &mut encoder, (c, frame, object), mode, settings, &maps);
-            stamps.write(&mut encoder, 3);
-            self.record_resolve(gpu, &mut encoder, c, &gb, frame, object, mode);
-            stamps.write(&mut encoder, 4);
-            stamps.record_resolve(&mut encoder);
-            times.cpu += t.elapsed();
-            gpu.submit_and_wait(encoder)?;
-            if let [g, m, k, r] = stamps.read(gpu)?[..] {
-                (times.gbuffer, times.shadow_maps, times.masks, times.resolve) = (g, m, k, r);
-            }
-            times.clock = gpu::Clock::GpuTimestamps;
-            return Ok((self.read_output(gpu)?, times, maps.work));
-        }
-        let stage = |label, record: &mut dyn FnMut(&mut wgpu::CommandEncoder) -> Result<(), GpuError>| {
-            let t = Instant::now();
-            let mut encoder = gpu.encoder(label);
-            record(&mut encoder)?;
-            gpu.submit_and_wait(encoder)?;
-            Ok::<_, GpuError>(t.elapsed())
-        };
-        let mut gb = None;
-        times.gbuffer = stage("composite g-buffer", &mut |e| {
-            gb = Some(self.record_gbuffer(gpu, e, c, object, settings)?);
-            Ok(())
-        })?;
-        let gb = gb.ok_or_else(|| GpuError::Failed("composite: no G-buffer".into()))?;
-        let mut maps = None;
-        times.shadow_maps = stage("composite maps", &mut |e| {
-            maps = Some(self.record_maps(gpu, e, c, frame, object, settings)?);
-            Ok(())
-        })?;
-        let maps = maps.ok_or_else(|| GpuError::Failed("composite: no maps".into()))?;
-        times.masks = stage("composite masks", &mut |e| {
-            self.record_masks(gpu, e, (c, frame, object), mode, settings, &maps);
-            Ok(())
-        })?;
-        let t = Instant::now();
-        let mut encoder = gpu.encoder("composite resolve");
-        self.record_resolve(gpu, &mut encoder, c, &gb, frame, object, mode);
-        gpu.submit_and_wait(encoder)?;
-        let image = self.read_output(gpu)?;
-        times.resolve = t.elapsed();
-        Ok((image, times, maps.work))
-    }
-
     /// Records the whole composite of `frame` for `object` in `mode` into `encoder`, without
     /// submitting: the G-buffer of the reconstruction with the object, every representative's
     /// map, the masks and darkening, the resolve into [`GpuCompositor::output`] (the 8-bit
@@ -365,10 +294,34 @@ impl GpuCompositor {
         mode: Mode,
         settings: &GpuSettings,
     ) -> Result<MapWork, GpuError> {
+        self.record_staged(gpu, encoder, (c, frame, object), mode, settings, &mut |_, _| Ok(()))
+    }
+
+    /// [`GpuCompositor::record`] with `between(encoder, k)` called before the first stage
+    /// (k = 0) and after each of the four (G-buffer, maps, masks, resolve: k = 1..=4): where
+    /// measurement writes a GPU timestamp, or, without them, submits the stage recorded so far
+    /// (swapping in a new encoder) and times it (`trade::composite_rows::composite`).
+    ///
+    /// # Errors
+    /// GPU failures; sizes beyond the device's limits; `between`'s own.
+    pub fn record_staged(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        (c, frame, object): (&Compositor, &FrameTransfers, &SyntheticObject),
+        mode: Mode,
+        settings: &GpuSettings,
+        between: &mut dyn FnMut(&mut wgpu::CommandEncoder, usize) -> Result<(), GpuError>,
+    ) -> Result<MapWork, GpuError> {
+        between(encoder, 0)?;
         let gb = self.record_gbuffer(gpu, encoder, c, object, settings)?;
+        between(encoder, 1)?;
         let maps = self.record_maps(gpu, encoder, c, frame, object, settings)?;
+        between(encoder, 2)?;
         self.record_masks(gpu, encoder, (c, frame, object), mode, settings, &maps);
+        between(encoder, 3)?;
         self.record_resolve(gpu, encoder, c, &gb, frame, object, mode);
+        between(encoder, 4)?;
         Ok(maps.work)
     }
 

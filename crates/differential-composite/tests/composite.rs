@@ -56,7 +56,7 @@ fn cpu_composite(s: &Session, frame: &FrameTransfers, object: &SyntheticObject, 
 
 fn gpu_composite(frame: &FrameTransfers, object: &SyntheticObject, mode: Mode) -> Vec<[u8; 3]> {
     let (g, gc) = gpu();
-    gc.composite(g, &room().compositor, frame, object, mode, &GpuSettings::default())
+    trade::composite_rows::composite(g, gc, (&room().compositor, frame, object), mode, &GpuSettings::default())
         .unwrap_or_else(|e| panic!("{e}"))
         .0
 }
@@ -315,7 +315,8 @@ fn hemispherical_sources_render_one_paraboloid_view_and_cubes_six() {
     let (g, gc) = gpu();
     let run = |patch_maps, layers_per_array| {
         let settings = GpuSettings { patch_maps, layers_per_array, ..GpuSettings::default() };
-        gc.composite(g, c, &frame, &object, Mode::Hdr, &settings).unwrap_or_else(|e| panic!("{e}"))
+        trade::composite_rows::composite(g, gc, (c, &frame, &object), Mode::Hdr, &settings)
+            .unwrap_or_else(|e| panic!("{e}"))
     };
     let (paraboloid, _, work) = run(shadowmap_paraboloid::Technique::DualParaboloid, None);
     assert_eq!((work.views, work.hemispheres_skipped), (patches, patches));
@@ -344,7 +345,8 @@ fn the_composite_recorded_into_one_encoder_equals_the_measured_one() {
             let settings = GpuSettings::default();
             let before = g.counters();
             let wall = std::time::Instant::now();
-            let (measured, times, work) = gc.composite(g, c, &frame, &object, mode, &settings).unwrap();
+            let (measured, times, work) =
+                trade::composite_rows::composite(g, gc, (c, &frame, &object), mode, &settings).unwrap();
             let (wall, measuring) = (wall.elapsed(), g.counters() - before);
             // with timestamps inside encoders the measured frame is the recorded one: one
             // submission (and the image's readback), its stages between timestamps within the

@@ -138,7 +138,8 @@ pub(crate) fn run(args: &CompositeArgs) -> Result<(), String> {
     // the HDR image of the main setting, recomposited once more (the rows keep 8-bit images)
     let hdr = if main.mode == Mode::Hdr {
         let frame = c.frame(&object, main.passes);
-        gc.composite(&gpu, c, &frame, &object, main.mode, &gpu_settings).map_err(|e| e.to_string())?;
+        trade::composite_rows::composite(&gpu, &gc, (c, &frame, &object), main.mode, &gpu_settings)
+            .map_err(|e| e.to_string())?;
         Some(gc.read_output_hdr(&gpu).map_err(|e| e.to_string())?)
     } else {
         None
@@ -191,14 +192,7 @@ pub(crate) fn run(args: &CompositeArgs) -> Result<(), String> {
             "sky_cones": session.lights.1,
             "size": [w, h],
             "adapter": gpu.info.name,
-            "rows": table.iter().map(|r| serde_json::json!({
-                "passes": r.passes,
-                "mode": r.mode_label().to_lowercase(),
-                "representatives": r.reps,
-                "ms_per_frame": ms(r.times.total()),
-                "error_rmse_codes": r.error.rmse_changed,
-                "error_mae_codes": r.error.mae_changed,
-            })).collect::<Vec<_>>(),
+            "rows": table.iter().map(trade::composite_rows::Row::json).collect::<Vec<_>>(),
         });
         print_json(v, main);
         return Ok(());
@@ -334,7 +328,8 @@ fn moving(
         let offset = Vec3::new(-1.0 + 2.0 * s, 0.0, 0.0);
         let moved = object.moved(offset);
         let frame = c.frame(&moved, args.passes);
-        let (_, times, _) = gc.composite(gpu, c, &frame, &moved, mode, settings).map_err(|e| e.to_string())?;
+        let (_, times, _) = trade::composite_rows::composite(gpu, gc, (c, &frame, &moved), mode, settings)
+            .map_err(|e| e.to_string())?;
         let excluded = sources - frame.occluded_sources.min(sources);
         if args.json {
             out.push(serde_json::json!({"frame": k, "offset": offset.to_array(), "ms_per_frame": ms(times.total()), "representatives": frame.reps.len(), "sources_excluded": excluded}));

@@ -287,17 +287,7 @@ pub(crate) fn run(args: &CompositeArgs) -> Result<(), String> {
             "estimate_reflectances": args.estimate_reflectances,
             "prune": args.prune.unwrap_or(0.02),
             "adapter": gpu.info.name,
-            "rows": table.iter().map(|r| {
-                let mut o = r.times_json();
-                o.extend([
-                    ("passes".to_string(), serde_json::json!(r.passes)),
-                    ("mode".to_string(), serde_json::json!(r.mode_label().to_lowercase())),
-                    ("representatives".to_string(), serde_json::json!(r.reps)),
-                    ("error_mae_codes".to_string(), serde_json::json!(r.error.mae_changed)),
-                    ("error_rmse_codes".to_string(), serde_json::json!(r.error.rmse_changed)),
-                ]);
-                o
-            }).collect::<Vec<_>>(),
+            "rows": table.iter().map(trade::composite_rows::Row::json).collect::<Vec<_>>(),
         });
         print_json(v, main);
         return Ok(());
@@ -363,7 +353,8 @@ fn moving(
         let at = start + offset;
         let object = object.moved(offset);
         let frame = c.frame(&object, args.passes);
-        let (image, times, _) = gc.composite(gpu, c, &frame, &object, mode, settings).map_err(|e| e.to_string())?;
+        let (image, times, _) = trade::composite_rows::composite(gpu, gc, (c, &frame, &object), mode, settings)
+            .map_err(|e| e.to_string())?;
         let truth = session.truth(&object).map_err(e)?;
         let err = code_error(&image, &truth, &c.photo_ldr);
         if args.json {

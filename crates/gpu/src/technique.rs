@@ -286,7 +286,7 @@ impl LightStamps {
     /// # Errors
     /// [`GpuError::TooLarge`] past the queries one set holds.
     pub fn new(gpu: &Gpu, lights: usize) -> Result<Option<Self>, GpuError> {
-        let stamps = crate::timer::Stamps::new(gpu, lights as u64, 2, "lights timed in one submission")?;
+        let stamps = crate::timer::Stamps::new(gpu, 2 * lights as u64, "timestamps of lights timed in one submission")?;
         Ok(stamps.map(|stamps| Self { stamps, lights }))
     }
 

@@ -37,39 +37,17 @@ impl Gpu {
     /// # Errors
     /// As [`Gpu::submit_and_wait`].
     pub fn measure(&self, record: impl FnOnce(&mut wgpu::CommandEncoder)) -> Result<(Duration, Clock), GpuError> {
-        let timestamps = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
         let mut encoder = self.encoder("measure");
-        if !self.features.contains(timestamps) {
+        let Some(stamps) = StageStamps::new(self, 1)? else {
             record(&mut encoder);
             return Ok((self.submit_timed(encoder)?, Clock::WallTime));
-        }
-        let set = self.device.create_query_set(&wgpu::QuerySetDescriptor {
-            label: Some("measure"),
-            ty: wgpu::QueryType::Timestamp,
-            count: 2,
-        });
-        let resolve = self.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("timestamps"),
-            size: 16,
-            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let read = self.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("timestamps readback"),
-            size: 16,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        encoder.write_timestamp(&set, 0);
+        };
+        stamps.write(&mut encoder, 0);
         record(&mut encoder);
-        encoder.write_timestamp(&set, 1);
-        encoder.resolve_query_set(&set, 0..2, &resolve, 0);
-        encoder.copy_buffer_to_buffer(&resolve, 0, &read, 0, 16);
+        stamps.write(&mut encoder, 1);
+        stamps.record_resolve(&mut encoder);
         self.submit_and_wait(encoder)?;
-        let bytes = crate::readback::read_mapped(self, &read)?;
-        let ticks: [u64; 2] = bytemuck::pod_read_unaligned(&bytes[..16]);
-        let ns = ticks[1].saturating_sub(ticks[0]) as f64 * f64::from(self.queue.get_timestamp_period());
-        Ok((Duration::from_nanos(ns as u64), Clock::GpuTimestamps))
+        Ok((stamps.read(self)?.first().copied().unwrap_or_default(), Clock::GpuTimestamps))
     }
 }
 
@@ -86,17 +64,15 @@ impl Stamps {
     /// `count` stamps; `None` without timestamps inside encoders or for none.
     ///
     /// # Errors
-    /// [`GpuError::TooLarge`] past the queries one set holds (`what` and `units` of `per` stamps
-    /// name the request).
-    pub(crate) fn new(gpu: &Gpu, units: u64, per: u64, what: &'static str) -> Result<Option<Self>, GpuError> {
+    /// [`GpuError::TooLarge`] past the queries one set holds (`what` names the request).
+    pub(crate) fn new(gpu: &Gpu, count: u64, what: &'static str) -> Result<Option<Self>, GpuError> {
         let timestamps = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
-        let count = units * per + u64::from(per == 1);
-        if !gpu.features.contains(timestamps) || units == 0 {
+        if !gpu.features.contains(timestamps) || count == 0 {
             return Ok(None);
         }
-        if count > u64::from(wgpu::QUERY_SET_MAX_QUERIES) {
-            let limit = (u64::from(wgpu::QUERY_SET_MAX_QUERIES) - u64::from(per == 1)) / per;
-            return Err(GpuError::TooLarge { what, size: units, limit });
+        let limit = u64::from(wgpu::QUERY_SET_MAX_QUERIES);
+        if count > limit {
+            return Err(GpuError::TooLarge { what, size: count, limit });
         }
         let set = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
             label: Some(what),
@@ -155,7 +131,8 @@ impl StageStamps {
     /// # Errors
     /// [`GpuError::TooLarge`] past the queries one set holds.
     pub fn new(gpu: &Gpu, stages: usize) -> Result<Option<Self>, GpuError> {
-        Ok(Stamps::new(gpu, stages as u64, 1, "stages timed in one submission")?.map(Self))
+        let count = if stages == 0 { 0 } else { stages as u64 + 1 };
+        Ok(Stamps::new(gpu, count, "timestamps of stages timed in one submission")?.map(Self))
     }
 
     /// Writes stamp `k` (0: before the first stage; k: after stage k - 1); past the last, nothing.

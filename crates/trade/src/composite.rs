@@ -97,7 +97,7 @@ pub fn measure_composite(
         let mode = if setting.ldr { Mode::Ldr } else { Mode::Hdr };
         if plan.repeats < 3 {
             let frame = c.frame(&case.object, setting.passes);
-            case.compositor.composite(gpu, c, &frame, &case.object, mode, &gpu_settings)?;
+            crate::composite_rows::composite(gpu, &case.compositor, (c, &frame, &case.object), mode, &gpu_settings)?;
         }
         let row = crate::composite_rows::rows(
             gpu,

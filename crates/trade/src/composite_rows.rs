@@ -2,7 +2,7 @@
 //! against the truth in 8-bit codes and its time per frame, beside Debevec's offline error; and
 //! Figure 3's datasets from a frame's vertices.
 
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use gpu::{Gpu, GpuError};
 
@@ -67,12 +67,79 @@ impl Row {
         out
     }
 
+    /// The setting as the commands' JSON lists it under `rows`: its passes, mode,
+    /// representatives, errors and [`Row::times_json`].
+    #[must_use]
+    pub fn json(&self) -> serde_json::Value {
+        let mut o = self.times_json();
+        o.extend([
+            ("passes".to_string(), serde_json::json!(self.passes)),
+            ("mode".to_string(), serde_json::json!(self.mode_label().to_lowercase())),
+            ("representatives".to_string(), serde_json::json!(self.reps)),
+            ("error_mae_codes".to_string(), serde_json::json!(self.error.mae_changed)),
+            ("error_rmse_codes".to_string(), serde_json::json!(self.error.rmse_changed)),
+        ]);
+        o.into()
+    }
+
     /// The frame's times in milliseconds: total, CPU, G-buffer, maps, masks, resolve.
     #[must_use]
     pub fn times_ms(&self) -> [f64; 6] {
         let t = &self.times;
         [t.total(), t.cpu, t.gbuffer, t.shadow_maps, t.masks, t.resolve].map(ms)
     }
+}
+
+/// Composites `frame` (made by `c.frame`) for `object` in `mode`, measured: the 8-bit image,
+/// where the time went and the shadow maps' views. The frame is [`GpuCompositor::record`]'s
+/// recording: with timestamps inside encoders, one submission with a GPU timestamp between its
+/// stages; without, each stage submitted and waited for on the wall clock. Then the image is
+/// read back (not timed). `cpu` is `frame`'s own and the recording's.
+///
+/// # Errors
+/// GPU failures.
+pub fn composite(
+    gpu: &Gpu,
+    gc: &GpuCompositor,
+    (c, frame, object): (&Compositor, &FrameTransfers, &SyntheticObject),
+    mode: Mode,
+    settings: &GpuSettings,
+) -> Result<(Vec<[u8; 3]>, FrameTimes, MapWork), GpuError> {
+    let mut times = FrameTimes { cpu: frame.cpu(), ..FrameTimes::default() };
+    let mut encoder = gpu.encoder("composite, measured");
+    let work = if let Some(stamps) = gpu::StageStamps::new(gpu, 4)? {
+        let t = Instant::now();
+        let mut stamp = |e: &mut wgpu::CommandEncoder, k: usize| {
+            stamps.write(e, k as u32);
+            Ok(())
+        };
+        let work = gc.record_staged(gpu, &mut encoder, (c, frame, object), mode, settings, &mut stamp)?;
+        stamps.record_resolve(&mut encoder);
+        times.cpu += t.elapsed();
+        gpu.submit_and_wait(encoder)?;
+        if let [g, m, k, r] = stamps.read(gpu)?[..] {
+            (times.gbuffer, times.shadow_maps, times.masks, times.resolve) = (g, m, k, r);
+        }
+        times.clock = gpu::Clock::GpuTimestamps;
+        work
+    } else {
+        // each stage recorded so far submitted and waited for, a new encoder in its place
+        let mut stages = [Duration::ZERO; 4];
+        let mut t = Instant::now();
+        let mut submit = |e: &mut wgpu::CommandEncoder, k: usize| {
+            if k > 0 {
+                gpu.submit_and_wait(std::mem::replace(e, gpu.encoder("composite, measured")))?;
+                stages[k - 1] = t.elapsed();
+            }
+            t = Instant::now();
+            Ok(())
+        };
+        let work = gc.record_staged(gpu, &mut encoder, (c, frame, object), mode, settings, &mut submit)?;
+        [times.gbuffer, times.shadow_maps, times.masks, times.resolve] = stages;
+        times.clock = gpu::Clock::WallTime;
+        work
+    };
+    Ok((gc.read_output(gpu)?, times, work))
 }
 
 /// Composites `object` with each of `passes` in each of `modes`, `repeats` times each (the
@@ -98,7 +165,7 @@ pub fn rows(
             let mut runs: Vec<(FrameTransfers, Vec<[u8; 3]>, FrameTimes, MapWork)> = Vec::new();
             for _ in 0..repeats.max(1) {
                 let frame = c.frame(object, n);
-                let (image, times, work) = gc.composite(gpu, c, &frame, object, mode, settings)?;
+                let (image, times, work) = composite(gpu, gc, (c, &frame, object), mode, settings)?;
                 runs.push((frame, image, times, work));
             }
             runs.sort_by_key(|r| r.2.total());

@@ -85,7 +85,8 @@ fn composite(session: &BackdropSession, object: &SyntheticObject, cull_masks: bo
         ..GpuSettings::default()
     };
     let frame = c.frame(object, 50);
-    let (image, _, _) = gc.composite(gpu(), c, &frame, object, Mode::Hdr, &settings).unwrap_or_else(|e| panic!("{e}"));
+    let (image, _, _) = trade::composite_rows::composite(gpu(), &gc, (c, &frame, object), Mode::Hdr, &settings)
+        .unwrap_or_else(|e| panic!("{e}"));
     (image, gc.read_output_hdr(gpu()).unwrap_or_else(|e| panic!("{e}")))
 }
 
