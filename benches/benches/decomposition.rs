@@ -10,12 +10,10 @@ use std::time::Duration;
 
 fn decomposition(c: &mut Criterion) {
     let gpu = Gpu::new().unwrap_or_else(|e| panic!("{e}"));
-    // criterion passes --bench when benchmarking; a smoke run gets a small frame
-    let size = if std::env::args().any(|a| a == "--bench") { (1600, 1200) } else { (160, 120) };
+    let size = if envshadow_benches::benchmarking() { (1600, 1200) } else { (160, 120) };
     let frame =
         Frame::new(&gpu, "gallery", size, &envshadow_benches::bench_map(), 32).unwrap_or_else(|e| panic!("{e}"));
-    let mut group = c.benchmark_group(format!("decomposition_gallery_{}x{}", size.0, size.1));
-    group.sample_size(10);
+    let mut group = envshadow_benches::slow_group(c, format!("decomposition_gallery_{}x{}", size.0, size.1));
     for (name, scale) in [("indirects_full", 1), ("indirects_half", 2), ("indirects_quarter", 4)] {
         group.bench_function(name, |b| {
             b.iter_custom(|iters| {

@@ -11,8 +11,7 @@ fn env_direct(c: &mut Criterion) {
     let env = EnvLight::new(&map);
     let bvh = SceneBvh::new(&scene);
     let pixels = u64::from(scene.camera.width * scene.camera.height);
-    let mut group = c.benchmark_group("ref_tracer");
-    group.sample_size(10);
+    let mut group = envshadow_benches::slow_group(c, "ref_tracer");
     group.throughput(Throughput::Elements(pixels));
     let mut seed = 0;
     group.bench_function("spheres_box_env_direct_640x480_1spp", |b| {

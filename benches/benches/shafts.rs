@@ -10,14 +10,13 @@ use shaft_hierarchy::{Occlusion, Traversal};
 use trade::shafts::object_path;
 
 fn shafts(c: &mut Criterion) {
-    let full = std::env::args().any(|a| a == "--bench");
+    let full = envshadow_benches::benchmarking();
     let perturbation = Perturbation { coarsen: if full { 1 } else { 2 }, ..Perturbation::NONE };
     let mut scene = RealScene::builtin_with("ar_room", &perturbation).unwrap_or_else(|e| panic!("{e}"));
     let bvh = ref_tracer::SceneBvh::new(&scene.to_scene());
     solve(&mut scene, &bvh, None, &SolveSettings::default()).unwrap_or_else(|e| panic!("{e}"));
     let settings = PreprocessSettings::PAPER;
-    let mut group = c.benchmark_group(format!("shafts_{}_patches", scene.patches.len()));
-    group.sample_size(10);
+    let mut group = envshadow_benches::slow_group(c, format!("shafts_{}_patches", scene.patches.len()));
     group.bench_function("preprocess", |b| {
         b.iter(|| envshadow_benches::ok(build(&scene, &[], &bvh, &settings)).1.leaf_shafts())
     });

@@ -12,8 +12,7 @@ fn soft_shadows(c: &mut Criterion) {
     let l = light(4.0);
     for size in [(640, 480), (1920, 1080)] {
         let frame = Frame::new(&gpu, "three_boxes", size).unwrap_or_else(|e| panic!("{e}"));
-        let mut group = c.benchmark_group(format!("soft_shadows_three_boxes_{}x{}", size.0, size.1));
-        group.sample_size(10);
+        let mut group = envshadow_benches::slow_group(c, format!("soft_shadows_three_boxes_{}x{}", size.0, size.1));
         for e in entries(&gpu, &frame.scene).unwrap_or_else(|e| panic!("{e}")) {
             group.bench_function(e.technique.name(), |b| {
                 b.iter_custom(|iters| {
