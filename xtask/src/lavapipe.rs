@@ -1,6 +1,7 @@
 //! The GPU a command runs on: the best adapter present, or the one `--adapter` names. Only on a
 //! machine with no adapter at all is Mesa's lavapipe (software Vulkan) installed — with apt, when
-//! we run as root — or asked for with the exact command to run.
+//! we run as root — or asked for with the exact command to run; so is Xvfb, the display the
+//! viewer's tests open their window on, where there is none.
 
 use gpu::{Gpu, GpuError};
 use std::path::Path;
@@ -23,26 +24,41 @@ fn is_root() -> bool {
 
 /// Installs lavapipe when missing (as root), or explains how.
 pub fn ensure() -> Result<(), String> {
-    if installed() {
+    apt_install("Mesa's lavapipe (software Vulkan)", INSTALL, installed)
+}
+
+const XVFB_INSTALL: &str = "apt-get update && apt-get install -y --no-install-recommends xvfb xauth";
+
+/// Whether `xvfb-run` is on the PATH.
+pub fn xvfb_installed() -> bool {
+    Command::new("sh").args(["-c", "command -v xvfb-run"]).output().is_ok_and(|o| o.status.success())
+}
+
+/// Installs Xvfb (with `xvfb-run` and `xauth`) when missing (as root), or explains how: the
+/// viewer's tests open their window on it.
+pub fn ensure_xvfb() -> Result<(), String> {
+    apt_install("Xvfb (the viewer's tests' display)", XVFB_INSTALL, xvfb_installed)
+}
+
+/// Runs `install` with apt as root when `present` says `what` is missing, or explains how.
+fn apt_install(what: &str, install: &str, present: fn() -> bool) -> Result<(), String> {
+    if present() {
         return Ok(());
     }
     if !cfg!(target_os = "linux") || !Path::new("/usr/bin/apt-get").exists() {
-        return Err(format!(
-            "Mesa's lavapipe (software Vulkan) is missing and this is not a Debian/Ubuntu system: \
-             install Mesa's Vulkan drivers (on Debian: {INSTALL})"
-        ));
+        return Err(format!("{what} is missing and this is not a Debian/Ubuntu system (on Debian: {install})"));
     }
     if !is_root() {
-        return Err(format!("Mesa's lavapipe (software Vulkan) is missing: run `sudo sh -c '{INSTALL}'`"));
+        return Err(format!("{what} is missing: run `sudo sh -c '{install}'`"));
     }
-    outln!("installing Mesa's lavapipe: {INSTALL}");
+    outln!("installing {what}: {install}");
     let status = Command::new("sh")
-        .args(["-c", INSTALL])
+        .args(["-c", install])
         .env("DEBIAN_FRONTEND", "noninteractive")
         .status()
         .map_err(|e| format!("cannot run apt-get: {e}"))?;
-    if !status.success() || !installed() {
-        return Err(format!("installing lavapipe failed ({status}); run `{INSTALL}` by hand"));
+    if !status.success() || !present() {
+        return Err(format!("installing {what} failed ({status}); run `{install}` by hand"));
     }
     Ok(())
 }

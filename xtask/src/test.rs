@@ -1,7 +1,8 @@
 //! `cargo xtask test`: the whole test suite, as CI runs it.
 //!
 //! Unit, integration and doc tests of every crate (the GPU ones on the best adapter present, or
-//! the one `--adapter` names; lavapipe where there is no GPU) and one smoke run of every
+//! the one `--adapter` names; lavapipe where there is no GPU; the viewer's window on Xvfb,
+//! installed where missing) and one smoke run of every
 //! criterion bench (so benches never rot). The main job is among the tests: `cargo xtask
 //! validate --quick` from a copied binary, with its thresholds, checking that docs/measured.md's
 //! quick validate figures are this code's (xtask's `cli` test; the full run took 650-800 s of a
@@ -12,6 +13,7 @@ use std::time::Instant;
 
 pub fn run(adapter: Option<&str>, extra: &[String]) -> Result<(), String> {
     let chosen = crate::lavapipe::ensure_adapter(adapter)?;
+    crate::lavapipe::ensure_xvfb()?;
     outln!("xtask test: GPU tests on {chosen}");
     let start = Instant::now();
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());

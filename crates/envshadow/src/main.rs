@@ -1,7 +1,8 @@
 //! `envshadow`: the user's tool. Statistics of a map (`info`), its lights (`extract`), the
 //! reference render of a built-in scene or a glTF 2.0 model (`render`), image error (`compare`),
 //! an object composited into a photograph (`composite`) and a built-in scene's geometry
-//! (`scene`). One module per command; the work is the library crates'.
+//! (`scene`), and a window on the real-time frame (`view`). One module per command; the work is
+//! the library crates'.
 
 #![allow(clippy::print_stdout, clippy::print_stderr)]
 
@@ -19,6 +20,7 @@ mod extract;
 mod info;
 mod render;
 mod scene;
+mod view;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -62,6 +64,14 @@ enum Command {
         after_help = "Example: envshadow render --scene model.glb --ground --envmap map.exr --integrator env-direct --spp 64 --size 640x480 --out render.exr"
     )]
     Render(render::RenderArgs),
+    /// A window on the real-time frame: a built-in scene or your glTF model lit by your map,
+    /// its soft shadows drawn by the technique chosen. Mouse: orbit (left), pan (right), zoom
+    /// (wheel), move the object (ctrl + left, arrows); T: next technique; +/-: lights; P:
+    /// screenshot; drop a map or model on the window to load it.
+    #[command(after_help = "Examples:
+  envshadow view --envmap map.exr --scene model.glb --ground
+  envshadow view --scene spheres_box --frames 60 --orbit 3 --screenshot shot.png --json")]
+    View(view::ViewArgs),
     /// Decompose a map into shadow-casting lights + ambient: DIR/lights.json, ambient.exr,
     /// lights.gltf (KHR_lights_punctual) and overlay.png.
     #[command(after_help = "Example: envshadow extract map.exr --method emissive-split --lights 16 --out lights/")]
@@ -130,6 +140,7 @@ fn main() -> ExitCode {
             scene::run(&name, obj.as_deref(), gltf.as_deref(), without_ground)
         }
         Command::Render(args) => render::run(&args),
+        Command::View(args) => view::run(&args),
         Command::Compare { reference, test } => render::compare(&reference, &test),
         Command::Extract { path, method, lights, out, lux_per_unit } => {
             extract::run(&path, &method, lights, out.as_deref(), lux_per_unit)

@@ -1,0 +1,405 @@
+//! The window: winit's event loop, a wgpu surface on the adapter that can present to it, the
+//! device the toolkit is handed (`gpu::Gpu::from_device`, as a renderer hands it its own), and
+//! the input.
+//!
+//! Keys: `T` the next technique, `+` / `-` twice or half the lights, arrows (or W A S D) move
+//! the scene's object on the ground, `P` saves a screenshot, `Esc` quits. Mouse: left drag
+//! orbits, right drag (or shift + left) pans, the wheel zooms, ctrl + left drag moves the object.
+//! Files dropped on the window load: a map or a model.
+
+use super::display::{Display, PendingShot};
+use super::{Content, Session, ViewArgs, ViewTechnique, finish_run};
+use gpu::Gpu;
+use std::sync::Arc;
+use std::time::Instant;
+use winit::application::ApplicationHandler;
+use winit::dpi::PhysicalSize;
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::keyboard::{Key, ModifiersState, NamedKey};
+use winit::window::{Window, WindowId};
+
+/// Opens the window and runs until it closes (or `--frames` are done).
+///
+/// # Errors
+/// No display; no adapter that can present to the window; GPU failures; the run's own.
+pub(crate) fn run(content: Content, technique: ViewTechnique, args: &ViewArgs) -> Result<(), String> {
+    let event_loop = EventLoop::new()
+        .map_err(|e| format!("cannot open a window: {e} (no display? run under xvfb-run, or add --offscreen)"))?;
+    event_loop.set_control_flow(ControlFlow::Poll);
+    let mut app = App {
+        args,
+        technique,
+        content: Some(content),
+        live: None,
+        error: None,
+        in_flight: None,
+        started: None,
+        drag: Drag::default(),
+        modifiers: ModifiersState::empty(),
+        shot_asked: false,
+        shots_saved: 0,
+    };
+    event_loop.run_app(&mut app).map_err(|e| e.to_string())?;
+    app.error.map_or(Ok(()), Err)
+}
+
+/// What the window holds once it exists.
+struct Live {
+    window: Arc<Window>,
+    instance: wgpu::Instance,
+    surface: wgpu::Surface<'static>,
+    config: wgpu::SurfaceConfiguration,
+    gpu: Gpu,
+    session: Session,
+    display: Display,
+    /// Whether the surface's images can be copied (the screenshot is then what was shown).
+    copyable: bool,
+}
+
+#[derive(Default)]
+struct Drag {
+    left: bool,
+    right: bool,
+    last: Option<(f64, f64)>,
+}
+
+struct App<'a> {
+    args: &'a ViewArgs,
+    technique: ViewTechnique,
+    content: Option<Content>,
+    live: Option<Live>,
+    error: Option<String>,
+    /// The frame submitted last, read once the next one starts (one frame in flight).
+    in_flight: Option<gpu::RenderedFrame>,
+    /// When the last frame started.
+    started: Option<Instant>,
+    drag: Drag,
+    modifiers: ModifiersState,
+    /// The `P` key was pressed: the next frame is saved.
+    shot_asked: bool,
+    shots_saved: usize,
+}
+
+impl App<'_> {
+    fn fail(&mut self, event_loop: &ActiveEventLoop, e: String) {
+        self.error.get_or_insert(e);
+        event_loop.exit();
+    }
+
+    fn open(&mut self, event_loop: &ActiveEventLoop) -> Result<Live, String> {
+        let content = self.content.take().ok_or("the window was opened twice")?;
+        let (w, h) = self.args.size;
+        let attributes = Window::default_attributes()
+            .with_title("envshadow")
+            .with_inner_size(PhysicalSize::new(w, h))
+            .with_resizable(self.args.frames.is_none());
+        let window = Arc::new(event_loop.create_window(attributes).map_err(|e| format!("cannot open a window: {e}"))?);
+        let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        descriptor.backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::PRIMARY);
+        let backends = descriptor.backends;
+        let instance = wgpu::Instance::new(descriptor);
+        let surface =
+            instance.create_surface(Arc::clone(&window)).map_err(|e| format!("cannot draw into the window: {e}"))?;
+        let adapters: Vec<wgpu::Adapter> = pollster::block_on(instance.enumerate_adapters(backends))
+            .into_iter()
+            .filter(|a| a.is_surface_supported(&surface))
+            .collect();
+        let infos: Vec<wgpu::AdapterInfo> = adapters.iter().map(wgpu::Adapter::get_info).collect();
+        let wanted =
+            self.args.adapter.clone().or_else(|| std::env::var(gpu::ADAPTER_ENV).ok().filter(|n| !n.is_empty()));
+        let k = gpu::pick_adapter(&infos, wanted.as_deref()).ok_or_else(|| {
+            let found: Vec<String> = infos.iter().map(gpu::describe_adapter).collect();
+            format!(
+                "no adapter that can present to the window{}; found: {}",
+                wanted.map_or(String::new(), |w| format!(" matches {w:?}")),
+                if found.is_empty() { "none".to_string() } else { found.join("; ") }
+            )
+        })?;
+        let adapter = &adapters[k];
+        // what the toolkit uses when the device has it (as `gpu::Gpu` asks for itself)
+        let wanted = wgpu::Features::CLIP_DISTANCES
+            | wgpu::Features::FLOAT32_BLENDABLE
+            | wgpu::Features::TIMESTAMP_QUERY
+            | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("envshadow view"),
+            required_features: adapter.features() & wanted,
+            required_limits: adapter.limits(),
+            ..Default::default()
+        }))
+        .map_err(|e| format!("{}: cannot open a device: {e}", adapter.get_info().name))?;
+        let gpu = Gpu::from_device(device, queue, adapter.get_info());
+        let caps = surface.get_capabilities(adapter);
+        use wgpu::TextureFormat as F;
+        let format = [F::Rgba8UnormSrgb, F::Bgra8UnormSrgb, F::Rgba8Unorm, F::Bgra8Unorm]
+            .into_iter()
+            .find(|f| caps.formats.contains(f))
+            .ok_or_else(|| format!("the window offers no 8-bit format (it offers {:?})", caps.formats))?;
+        let copyable = caps.usages.contains(wgpu::TextureUsages::COPY_SRC);
+        let size = window.inner_size();
+        let config = wgpu::SurfaceConfiguration {
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | if copyable { wgpu::TextureUsages::COPY_SRC } else { wgpu::TextureUsages::empty() },
+            format,
+            width: size.width.max(1),
+            height: size.height.max(1),
+            // a scripted run measures frames, not the display's refresh
+            present_mode: if self.args.frames.is_some() {
+                wgpu::PresentMode::AutoNoVsync
+            } else {
+                wgpu::PresentMode::AutoVsync
+            },
+            desired_maximum_frame_latency: 2,
+            alpha_mode: caps.alpha_modes.first().copied().unwrap_or(wgpu::CompositeAlphaMode::Auto),
+            view_formats: Vec::new(),
+            color_space: wgpu::SurfaceColorSpace::Auto,
+        };
+        surface.configure(&gpu.device, &config);
+        let mut content = content;
+        (content.scene.camera.width, content.scene.camera.height) = (config.width, config.height);
+        let session = Session::new(&gpu, content, self.technique, self.args)?;
+        let display = Display::new(&gpu, format);
+        Ok(Live { window, instance, surface, config, gpu, session, display, copyable })
+    }
+
+    /// One frame: the previous one read, this one recorded, shown, and on the last scripted
+    /// frame the screenshot and the JSON.
+    fn frame(&mut self, event_loop: &ActiveEventLoop) -> Result<(), String> {
+        let Some(live) = self.live.as_mut() else { return Ok(()) };
+        let start = Instant::now();
+        // one frame in flight: the previous one's work waited for, its reports read
+        if let Some(previous) = self.in_flight.take() {
+            live.gpu.wait(None).map_err(|e| e.to_string())?;
+            live.session.finish(&live.gpu, previous)?;
+        }
+        if let Some(t) = self.started.replace(start) {
+            live.session.times.push(start - t);
+        }
+        let k = live.session.times.len();
+        if k == 1
+            && let Some(p) = &self.args.drop
+        {
+            let _ = live.session.load(&live.gpu, p);
+        }
+        if k > 0 {
+            live.session.orbit.rotate(self.args.orbit.to_radians(), 0.0);
+        }
+        let surface = match live.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(t) | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
+            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
+                self.started = None;
+                return Ok(());
+            }
+            wgpu::CurrentSurfaceTexture::Outdated => {
+                live.surface.configure(&live.gpu.device, &live.config);
+                self.started = None;
+                return Ok(());
+            }
+            wgpu::CurrentSurfaceTexture::Lost => {
+                live.surface = live
+                    .instance
+                    .create_surface(Arc::clone(&live.window))
+                    .map_err(|e| format!("the window's surface was lost: {e}"))?;
+                live.surface.configure(&live.gpu.device, &live.config);
+                self.started = None;
+                return Ok(());
+            }
+            other => return Err(format!("cannot draw into the window: {other:?}")),
+        };
+        let size = (surface.texture.width(), surface.texture.height());
+        live.session.stage.resize(&live.gpu, size)?;
+        let camera = live.session.camera();
+        let frame = live.session.stage.render(&live.gpu, &camera).map_err(|e| e.to_string())?;
+        let target = surface.texture.create_view(&wgpu::TextureViewDescriptor::default());
+        let mut encoder = live.gpu.encoder("display");
+        live.display.record(&live.gpu, &mut encoder, &frame.texture, live.session.stage.exposure(), &target);
+        let last = self.args.frames.is_some_and(|n| k + 1 >= n);
+        let mut shot = None;
+        if (last && self.args.screenshot.is_some()) || std::mem::take(&mut self.shot_asked) {
+            shot = Some(if live.copyable {
+                (PendingShot::record(&live.gpu, &mut encoder, &surface.texture).map_err(|e| e.to_string())?, "window")
+            } else {
+                // the same pass into a texture that can be copied
+                let t = super::display::offscreen_target(&live.gpu, size, super::OFFSCREEN_FORMAT);
+                let offscreen = Display::new(&live.gpu, super::OFFSCREEN_FORMAT);
+                let view = t.create_view(&wgpu::TextureViewDescriptor::default());
+                offscreen.record(&live.gpu, &mut encoder, &frame.texture, live.session.stage.exposure(), &view);
+                (PendingShot::record(&live.gpu, &mut encoder, &t).map_err(|e| e.to_string())?, "offscreen")
+            });
+        }
+        live.session.cpu.push(start.elapsed());
+        live.gpu.submit(encoder);
+        live.window.pre_present_notify();
+        live.gpu.queue.present(surface);
+        self.in_flight = Some(frame);
+        if last {
+            live.gpu.wait(None).map_err(|e| e.to_string())?;
+            if let Some(frame) = self.in_flight.take() {
+                live.session.finish(&live.gpu, frame)?;
+            }
+            live.session.times.push(start.elapsed());
+            let from = shot.as_ref().map_or("", |s| s.1);
+            finish_run(&live.gpu, &live.session, self.args, shot.map(|s| s.0), from)?;
+            event_loop.exit();
+            return Ok(());
+        }
+        if let Some((shot, _)) = shot {
+            // the `P` key's screenshot, numbered in the working folder
+            let ((w, h), rgb) = shot.finish(&live.gpu).map_err(|e| e.to_string())?;
+            self.shots_saved += 1;
+            let path = std::path::PathBuf::from(format!("envshadow-{}.png", self.shots_saved));
+            match envmap_sphere::io::save_png_srgb8(&path, w, h, &rgb) {
+                Ok(()) => eprintln!("saved {}", path.display()),
+                Err(e) => eprintln!("screenshot not saved: {e}"),
+            }
+        }
+        let s = &live.session;
+        let ms = s.times.last().map_or(0.0, |d| d.as_secs_f64() * 1e3);
+        live.window.set_title(&format!(
+            "envshadow: {} ({} lights, {} shadowed) {:.0} ms{}",
+            s.stage.technique.name(),
+            s.stage.lights,
+            s.shadowed,
+            ms,
+            s.messages.last().map_or(String::new(), |m| format!(" | {m}"))
+        ));
+        live.window.request_redraw();
+        Ok(())
+    }
+
+    fn key(&mut self, key: &Key) -> Result<(), String> {
+        let Some(live) = self.live.as_mut() else { return Ok(()) };
+        let s = &mut live.session;
+        let (right, forward) = s.orbit.ground_axes();
+        let step = s.step();
+        let gpu = &live.gpu;
+        match key {
+            Key::Named(NamedKey::ArrowLeft) => s.nudge(gpu, -step * right),
+            Key::Named(NamedKey::ArrowRight) => s.nudge(gpu, step * right),
+            Key::Named(NamedKey::ArrowUp) => s.nudge(gpu, step * forward),
+            Key::Named(NamedKey::ArrowDown) => s.nudge(gpu, -step * forward),
+            Key::Character(c) => match c.as_str() {
+                "a" | "A" => s.nudge(gpu, -step * right),
+                "d" | "D" => s.nudge(gpu, step * right),
+                "w" | "W" => s.nudge(gpu, step * forward),
+                "s" | "S" => s.nudge(gpu, -step * forward),
+                "t" | "T" => s.stage.technique = s.stage.technique.next(),
+                "+" | "=" => set_lights(s, gpu, (s.stage.lights * 2).min(super::MAX_LIGHTS)),
+                "-" => set_lights(s, gpu, (s.stage.lights / 2).max(1)),
+                "p" | "P" => self.shot_asked = true,
+                _ => {}
+            },
+            _ => {}
+        }
+        Ok(())
+    }
+
+    fn cursor(&mut self, x: f64, y: f64) {
+        let Some(live) = self.live.as_mut() else { return };
+        let Some((lx, ly)) = self.drag.last.replace((x, y)) else { return };
+        let (dx, dy) = ((x - lx) as f32, (y - ly) as f32);
+        let s = &mut live.session;
+        let h = live.config.height.max(1) as f32;
+        if self.drag.left && self.modifiers.control_key() {
+            let (right, forward) = s.orbit.ground_axes();
+            let scale = 2.0 * s.orbit.distance / h;
+            s.nudge(&live.gpu, scale * (dx * right - dy * forward));
+        } else if self.drag.right || (self.drag.left && self.modifiers.shift_key()) {
+            s.orbit.pan(-dx / h, dy / h);
+        } else if self.drag.left {
+            s.orbit.rotate(-dx * 0.008, dy * 0.008);
+        }
+    }
+}
+
+fn set_lights(s: &mut Session, gpu: &Gpu, lights: usize) {
+    if lights != s.stage.lights {
+        let map = s.map.clone();
+        if let Err(e) = s.stage.set_lights(gpu, &map, lights) {
+            s.messages.push(e);
+        }
+    }
+}
+
+impl ApplicationHandler for App<'_> {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.live.is_some() {
+            return;
+        }
+        match self.open(event_loop) {
+            Ok(live) => {
+                live.window.request_redraw();
+                self.live = Some(live);
+            }
+            Err(e) => self.fail(event_loop, e),
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
+        let r = match event {
+            WindowEvent::CloseRequested => {
+                event_loop.exit();
+                Ok(())
+            }
+            WindowEvent::RedrawRequested => self.frame(event_loop),
+            WindowEvent::Resized(size) => {
+                if let Some(live) = self.live.as_mut()
+                    && size.width > 0
+                    && size.height > 0
+                {
+                    (live.config.width, live.config.height) = (size.width, size.height);
+                    live.surface.configure(&live.gpu.device, &live.config);
+                }
+                Ok(())
+            }
+            WindowEvent::DroppedFile(path) => {
+                if let Some(live) = self.live.as_mut()
+                    && let Err(e) = live.session.load(&live.gpu, &path)
+                {
+                    eprintln!("not loaded: {e}");
+                }
+                Ok(())
+            }
+            WindowEvent::ModifiersChanged(m) => {
+                self.modifiers = m.state();
+                Ok(())
+            }
+            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
+                if event.logical_key == Key::Named(NamedKey::Escape) {
+                    event_loop.exit();
+                    Ok(())
+                } else {
+                    self.key(&event.logical_key)
+                }
+            }
+            WindowEvent::MouseInput { state, button, .. } => {
+                let down = state == ElementState::Pressed;
+                match button {
+                    MouseButton::Left => self.drag.left = down,
+                    MouseButton::Right | MouseButton::Middle => self.drag.right = down,
+                    _ => {}
+                }
+                Ok(())
+            }
+            WindowEvent::CursorMoved { position, .. } => {
+                self.cursor(position.x, position.y);
+                Ok(())
+            }
+            WindowEvent::MouseWheel { delta, .. } => {
+                let lines = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => y,
+                    MouseScrollDelta::PixelDelta(p) => (p.y / 40.0) as f32,
+                };
+                if let Some(live) = self.live.as_mut() {
+                    live.session.orbit.zoom(0.9f32.powf(lines));
+                }
+                Ok(())
+            }
+            _ => Ok(()),
+        };
+        if let Err(e) = r {
+            self.fail(event_loop, e);
+        }
+    }
+}
