@@ -83,6 +83,24 @@ impl Sh9 {
         std::array::from_fn(|k| self.coeffs[k] * IRRADIANCE_BAND_FACTORS[BAND[k]])
     }
 
+    /// The function turned by `rotation`: g(d) = f(rotation⁻¹ d), as a map turned by it projects
+    /// to. Exact: a band-limited function's rotation stays in its bands, and its projection is
+    /// integrated by the icosahedron's 12 vertices, a spherical 5-design (exact for the degree-4
+    /// products of two order-2 polynomials).
+    #[must_use]
+    pub fn rotated(&self, rotation: glam::Quat) -> Self {
+        let inverse = rotation.inverse();
+        let weight = 4.0 * std::f64::consts::PI / 12.0;
+        let mut acc = [DVec3::ZERO; 9];
+        for v in icosahedron() {
+            let g = self.eval(inverse * v).as_dvec3();
+            for (a, b) in acc.iter_mut().zip(sh9_basis(v)) {
+                *a += g * f64::from(b) * weight;
+            }
+        }
+        Self { coeffs: acc.map(|c| c.as_vec3()) }
+    }
+
     /// A map whose texels hold this function at their centres (a band-limited test map).
     #[must_use]
     pub fn to_map(&self, width: u32, height: u32) -> EnvMap {
@@ -90,9 +108,66 @@ impl Sh9 {
     }
 }
 
+/// The icosahedron's 12 unit vertices: (0, ±1, ±φ) and their cyclic permutations, normalized.
+fn icosahedron() -> [Vec3; 12] {
+    let phi = (1.0 + 5.0f32.sqrt()) / 2.0;
+    let mut out = [Vec3::ZERO; 12];
+    let mut k = 0;
+    for a in [-1.0, 1.0] {
+        for b in [-phi, phi] {
+            for v in [Vec3::new(0.0, a, b), Vec3::new(a, b, 0.0), Vec3::new(b, 0.0, a)] {
+                out[k] = v.normalize();
+                k += 1;
+            }
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn rotation_matches_the_projection_of_the_turned_map() {
+        // a band-limited function with every coefficient set, turned by whole texel columns:
+        // the turned map is exact, its projection the rotated coefficients
+        let sh =
+            Sh9 { coeffs: std::array::from_fn(|k| Vec3::new(1.0 + k as f32, 0.5 - 0.3 * k as f32, (k as f32).sin())) };
+        let (w, h) = (256, 128);
+        let map = sh.to_map(w, h);
+        for columns in [1u32, 37, 128] {
+            let turned = EnvMap::from_texels(w, h, |i, j| map.pixel((i + w - columns) % w, j));
+            // lat-long u grows with atan2(x, -z): a column is a turn of -2 pi / w about +Y
+            let angle = -std::f32::consts::TAU * columns as f32 / w as f32;
+            let want = Sh9::project(&turned);
+            let got = Sh9::project(&map).rotated(glam::Quat::from_rotation_y(angle));
+            for (g, t) in got.coeffs.iter().zip(want.coeffs) {
+                assert!((*g - t).abs().max_element() < 2e-3 * (1.0 + t.abs().max_element()), "{columns}: {g} vs {t}");
+            }
+        }
+    }
+
+    #[test]
+    fn rotations_compose_and_keep_the_function() {
+        let sh =
+            Sh9 { coeffs: std::array::from_fn(|k| Vec3::splat(1.0 / (1.0 + k as f32)) * Vec3::new(1.0, -2.0, 0.5)) };
+        let (a, b) = (
+            glam::Quat::from_rotation_y(0.7),
+            glam::Quat::from_axis_angle(Vec3::new(1.0, 2.0, -0.5).normalize(), -1.3),
+        );
+        let twice = sh.rotated(a).rotated(b);
+        let once = sh.rotated(b * a);
+        for d in [Vec3::X, Vec3::Y, Vec3::new(0.3, -0.4, 0.866).normalize()] {
+            assert!((twice.eval(d) - once.eval(d)).abs().max_element() < 1e-4);
+            // g(d) = f(R⁻¹ d)
+            assert!((sh.rotated(a).eval(d) - sh.eval(a.inverse() * d)).abs().max_element() < 1e-4);
+        }
+        let same = sh.rotated(glam::Quat::IDENTITY);
+        for (s, t) in same.coeffs.iter().zip(sh.coeffs) {
+            assert!((*s - t).abs().max_element() < 1e-5);
+        }
+    }
 
     #[test]
     fn basis_is_orthonormal_under_the_texel_quadrature() {

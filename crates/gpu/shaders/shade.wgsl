@@ -25,6 +25,9 @@ struct Params {
     // the prefiltered ambient of the specular lobe: x width, y height, z levels (0: none),
     // w side of the directional-albedo table
     ambient_info: vec4<u32>,
+    // the maps' turns about +Y (`Background::set_turn`): cos and sin of the background's, then
+    // of the specular ambient's
+    turn: vec4<f32>,
     // SH9 irradiance coefficients premultiplied by A_l
     sh: array<vec4<f32>, 9>,
 }
@@ -151,12 +154,18 @@ fn latlong_bilinear(t: texture_2d_array<f32>, layer: i32, size: vec2<u32>, dir: 
     return mix(top, bottom, fy);
 }
 
+// Where world direction `d` falls in a map turned about +Y by an angle of cosine `c` and sine
+// `s`: R(-angle) d.
+fn in_turned_map(d: vec3<f32>, c: f32, s: f32) -> vec3<f32> {
+    return vec3<f32>(c * d.x - s * d.z, d.y, s * d.x + c * d.z);
+}
+
 // What a camera ray that misses sees: the map, or black without one.
 fn background_radiance(dir: vec3<f32>) -> vec3<f32> {
     if params.counts.z == 0u || params.counts.w == 0u {
         return vec3<f32>(0.0);
     }
-    return latlong_bilinear(background, 0, params.counts.zw, dir);
+    return latlong_bilinear(background, 0, params.counts.zw, in_turned_map(dir, params.turn.x, params.turn.y));
 }
 
 // The ambient map on a GGX lobe by the split-sum approximation (`gpu::ambient`): the map
@@ -175,7 +184,7 @@ fn specular_ambient(m: Material, n: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
     // dominant direction, Lagarde and de Rousiers 2014)
     let alpha = roughness * roughness;
     let smooth_ = 1.0 - alpha;
-    let r = normalize(mix(n, reflect(-wo, n), smooth_ * (sqrt(smooth_) + alpha)));
+    let r = in_turned_map(normalize(mix(n, reflect(-wo, n), smooth_ * (sqrt(smooth_) + alpha))), params.turn.z, params.turn.w);
     let size = params.ambient_info.xy;
     let radiance = mix(latlong_bilinear(prefiltered, k0, size, r), latlong_bilinear(prefiltered, k1, size, r), x - f32(k0));
     // bilinear in the table, clamped at its edges (`DfgTable::lookup`)

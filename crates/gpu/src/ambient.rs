@@ -283,6 +283,7 @@ pub struct SpecularAmbient {
     pub(crate) table: wgpu::Texture,
     pub(crate) size: (u32, u32, u32),
     pub(crate) table_size: u32,
+    turn: f32,
 }
 
 impl SpecularAmbient {
@@ -329,6 +330,18 @@ impl SpecularAmbient {
         let t = table.size;
         let table_tex =
             texture("ambient dfg", (t, t, 1), wgpu::TextureFormat::Rg32Float, bytemuck::cast_slice(&table.values));
-        Ok(Self { levels, table: table_tex, size: (w, h, n), table_size: t })
+        Ok(Self { levels, table: table_tex, size: (w, h, n), table_size: t, turn: 0.0 })
+    }
+
+    /// Turns the prefiltered map about +Y by `radians`, as `Background::set_turn` turns the
+    /// background (the same map turns as one).
+    pub fn set_turn(&mut self, radians: f32) {
+        self.turn = if radians.is_finite() { radians.rem_euclid(TAU) } else { 0.0 };
+    }
+
+    /// The map's turn about +Y, radians in [0, 2 pi).
+    #[must_use]
+    pub fn turn(&self) -> f32 {
+        self.turn
     }
 }

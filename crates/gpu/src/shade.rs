@@ -166,6 +166,8 @@ struct ShadeUniform {
     corner: [f32; 4],
     counts: [u32; 4],
     ambient_info: [u32; 4],
+    // cos and sin of the background's turn, then of the specular ambient's
+    turn: [f32; 4],
     sh: [[f32; 4]; 9],
 }
 
@@ -317,6 +319,11 @@ impl ShadingPass {
                 bh,
             ],
             ambient_info: params.specular_ambient.map_or([0; 4], |s| [s.size.0, s.size.1, s.size.2, s.table_size]),
+            turn: {
+                let (sb, cb) = params.background.map_or(0.0, Background::turn).sin_cos();
+                let (ss, cs) = params.specular_ambient.map_or(0.0, SpecularAmbient::turn).sin_cos();
+                [cb, sb, cs, ss]
+            },
             sh,
         };
         let mut lights: Vec<LightUniform> = params
@@ -438,6 +445,7 @@ pub fn read_hdr(gpu: &Gpu, texture: &wgpu::Texture) -> Result<Vec<Vec3>, GpuErro
 pub struct Background {
     texture: wgpu::Texture,
     size: (u32, u32),
+    turn: f32,
 }
 
 impl Background {
@@ -470,6 +478,20 @@ impl Background {
             wgpu::util::TextureDataOrder::LayerMajor,
             bytemuck::cast_slice(texels),
         );
-        Ok(Self { texture, size: (w, h) })
+        Ok(Self { texture, size: (w, h), turn: 0.0 })
+    }
+
+    /// Turns the map about +Y by `radians` (a world direction d sees the map at R(-radians) d):
+    /// a viewer's turn of the environment, nothing uploaded again. The lights and the ambient of
+    /// the same map turn with it on the caller's side (`DistantLight` directions, `Sh9::rotated`,
+    /// `SpecularAmbient::set_turn`).
+    pub fn set_turn(&mut self, radians: f32) {
+        self.turn = if radians.is_finite() { radians.rem_euclid(std::f32::consts::TAU) } else { 0.0 };
+    }
+
+    /// The map's turn about +Y, radians in [0, 2 pi).
+    #[must_use]
+    pub fn turn(&self) -> f32 {
+        self.turn
     }
 }

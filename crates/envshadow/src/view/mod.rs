@@ -49,6 +49,10 @@ pub(crate) struct ViewArgs {
     /// Save the last frame as this PNG (with --frames).
     #[arg(long, requires = "frames")]
     pub screenshot: Option<PathBuf>,
+    /// Turn the map about the vertical by this many degrees (its lights, ambient and
+    /// background together; `Q` / `E` turn it by 15 degrees in the window).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub turn: f32,
     /// Turn the camera this many degrees about the target each frame.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub orbit: f32,
@@ -85,8 +89,10 @@ pub(crate) fn run(args: &ViewArgs) -> Result<(), String> {
     if !(1..=MAX_LIGHTS).contains(&args.lights) {
         return Err(format!("--lights {}: give 1 to {MAX_LIGHTS}", args.lights));
     }
-    if !args.orbit.is_finite() {
-        return Err(format!("--orbit {}: give a finite number of degrees", args.orbit));
+    for (name, degrees) in [("--orbit", args.orbit), ("--turn", args.turn)] {
+        if !degrees.is_finite() {
+            return Err(format!("{name} {degrees}: give a finite number of degrees"));
+        }
     }
     if args.size.0 == 0 || args.size.1 == 0 || args.size.0 > 16384 || args.size.1 > 16384 {
         return Err(format!("--size {}x{}: give 1 to 16384 a side", args.size.0, args.size.1));
@@ -145,7 +151,8 @@ impl Session {
     fn new(gpu: &Gpu, content: Content, technique: ViewTechnique, args: &ViewArgs) -> Result<Self, String> {
         let t = Instant::now();
         let camera = content.scene.camera;
-        let stage = stage::Stage::new(gpu, content.scene, &content.map, args.lights, technique)?;
+        let mut stage = stage::Stage::new(gpu, content.scene, &content.map, args.lights, technique)?;
+        stage.set_turn(args.turn.to_radians());
         Ok(Self {
             orbit: orbit::Orbit::from_camera(&camera),
             camera,
@@ -241,6 +248,7 @@ impl Session {
             "triangles": self.stage.scene().triangle_count(),
             "moving_object": self.stage.moving_object(),
             "lights": self.stage.lights,
+            "map_turn_degrees": self.stage.turn().to_degrees(),
             "lights_shadowed": self.shadowed,
             "lights_skipped": self.skipped.iter().map(|(why, n)| serde_json::json!({"why": why, "lights": n})).collect::<Vec<_>>(),
             "setup_ms": ms(&self.setup),

@@ -2,8 +2,9 @@
 //! device the toolkit is handed (`gpu::Gpu::from_device`, as a renderer hands it its own), and
 //! the input.
 //!
-//! Keys: `T` the next technique, `+` / `-` twice or half the lights, arrows (or W A S D) move
-//! the scene's object on the ground, `P` saves a screenshot, `Esc` quits. Mouse: left drag
+//! Keys: `T` the next technique, `+` / `-` twice or half the lights, `Q` / `E` turn the map,
+//! arrows (or W A S D) move the scene's object on the ground, `P` saves a screenshot, `Esc`
+//! quits. Mouse: left drag
 //! orbits, right drag (or shift + left) pans, the wheel zooms, ctrl + left drag moves the object.
 //! Files dropped on the window load: a map or a model.
 
@@ -285,6 +286,8 @@ impl App<'_> {
                 "w" | "W" => s.nudge(gpu, step * forward),
                 "s" | "S" => s.nudge(gpu, -step * forward),
                 "t" | "T" => s.stage.technique = s.stage.technique.next(),
+                "q" | "Q" => s.stage.set_turn(s.stage.turn() - 15f32.to_radians()),
+                "e" | "E" => s.stage.set_turn(s.stage.turn() + 15f32.to_radians()),
                 "+" | "=" => set_lights(s, gpu, (s.stage.lights * 2).min(super::MAX_LIGHTS)),
                 "-" => set_lights(s, gpu, (s.stage.lights / 2).max(1)),
                 "p" | "P" => self.shot_asked = true,
