@@ -40,6 +40,7 @@ pub(crate) fn run(content: Content, technique: ViewTechnique, args: &ViewArgs) -
         modifiers: ModifiersState::empty(),
         shot_asked: false,
         shots_saved: 0,
+        dropped: false,
     };
     event_loop.run_app(&mut app).map_err(|e| e.to_string())?;
     app.error.map_or(Ok(()), Err)
@@ -80,6 +81,8 @@ struct App<'a> {
     /// The `P` key was pressed: the next frame is saved.
     shot_asked: bool,
     shots_saved: usize,
+    /// `--drop`'s file was loaded (once, after the first frame).
+    dropped: bool,
 }
 
 impl App<'_> {
@@ -178,9 +181,11 @@ impl App<'_> {
             live.session.times.push(start - t);
         }
         let k = live.session.times.len();
-        if k == 1
+        if k >= 1
+            && !self.dropped
             && let Some(p) = &self.args.drop
         {
+            self.dropped = true;
             let _ = live.session.load(&live.gpu, p);
         }
         if k > 0 {
@@ -188,13 +193,16 @@ impl App<'_> {
         }
         let surface = match live.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(t) | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
+            // no image this time: try again on the next redraw (the loop only draws when asked)
             wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
                 self.started = None;
+                live.window.request_redraw();
                 return Ok(());
             }
             wgpu::CurrentSurfaceTexture::Outdated => {
                 live.surface.configure(&live.gpu.device, &live.config);
                 self.started = None;
+                live.window.request_redraw();
                 return Ok(());
             }
             wgpu::CurrentSurfaceTexture::Lost => {
@@ -204,6 +212,7 @@ impl App<'_> {
                     .map_err(|e| format!("the window's surface was lost: {e}"))?;
                 live.surface.configure(&live.gpu.device, &live.config);
                 self.started = None;
+                live.window.request_redraw();
                 return Ok(());
             }
             other => return Err(format!("cannot draw into the window: {other:?}")),
