@@ -70,6 +70,11 @@ struct Lighting {
     /// The map's turn about +Y, radians: the lights, the ambient's SH9, the background and the
     /// specular ambient turn together, nothing extracted again.
     turn: f32,
+    /// The decomposition's lights and ambient turned by `turn`, as frames draw them (made when
+    /// the turn changes, not each frame).
+    shade: Vec<ShadeLight>,
+    shapes: Vec<LightShape>,
+    ambient: envmap_sphere::Sh9,
     /// A white ground under the map, exposed to middle grey.
     exposure: f32,
 }
@@ -85,19 +90,31 @@ impl Lighting {
         let ground =
             envmap_sphere::luminance(envmap_sphere::Sh9::project(map).irradiance(Vec3::Y)) / std::f32::consts::PI;
         let exposure = if ground.is_finite() && ground > 0.0 { 0.18 / ground } else { 1.0 };
-        Ok(Self {
+        let mut lighting = Self {
             background: Background::upload(gpu, map).map_err(e)?,
             specular: SpecularAmbient::new(gpu, &decomposition.ambient, &PrefilterSettings::default()).map_err(e)?,
             decomposition,
             exposure,
             turn: 0.0,
-        })
+            shade: Vec::new(),
+            shapes: Vec::new(),
+            ambient: envmap_sphere::Sh9::default(),
+        };
+        lighting.set_turn(0.0);
+        Ok(lighting)
     }
 
     fn set_turn(&mut self, radians: f32) {
         self.background.set_turn(radians);
         self.specular.set_turn(radians);
         self.turn = self.background.turn();
+        let q = glam::Quat::from_rotation_y(self.turn);
+        let d = &self.decomposition;
+        let turned: Vec<scene::DistantLight> =
+            d.lights.iter().map(|l| scene::DistantLight { direction: q * l.light.direction, ..l.light }).collect();
+        self.shade = turned.iter().map(ShadeLight::from).collect();
+        self.shapes = turned.iter().map(LightShape::from).collect();
+        self.ambient = d.ambient_sh.rotated(q);
     }
 }
 
@@ -278,29 +295,26 @@ impl Stage {
     /// # Errors
     /// GPU failures.
     pub(crate) fn render(&self, gpu: &Gpu, camera: &scene::Camera) -> Result<RenderedFrame, GpuError> {
-        let d = &self.lighting.decomposition;
-        let q = glam::Quat::from_rotation_y(self.lighting.turn);
-        let turned: Vec<scene::DistantLight> =
-            d.lights.iter().map(|l| scene::DistantLight { direction: q * l.light.direction, ..l.light }).collect();
-        let lights: Vec<ShadeLight> = turned.iter().map(ShadeLight::from).collect();
-        let shapes: Vec<LightShape> = turned.iter().map(LightShape::from).collect();
-        let ambient = d.ambient_sh.rotated(q);
+        let l = &self.lighting;
+        let lights = &l.shade;
         let c = &self.content;
         let view = GBufferPass::camera_view(&c.geometry, camera);
         let (directs, shadows): (usize, Option<FrameShadows>) = match self.technique {
-            ViewTechnique::Paper001 => (d.directs(), Some(FrameShadows { direct: &c.wedges, indirect: &c.maps })),
+            ViewTechnique::Paper001 => {
+                (l.decomposition.directs(), Some(FrameShadows { direct: &c.wedges, indirect: &c.maps }))
+            }
             ViewTechnique::Wedges => (lights.len(), Some(both(&c.wedges))),
             ViewTechnique::Maps => (lights.len(), Some(both(&c.maps))),
             ViewTechnique::Pcss => (lights.len(), Some(both(&c.pcss))),
             ViewTechnique::None => (lights.len(), None),
         };
         let frame_lights = FrameLights {
-            lights: &lights,
-            shapes: &shapes,
+            lights,
+            shapes: &l.shapes,
             directs,
-            ambient: Some(&ambient),
-            specular_ambient: Some(&self.lighting.specular),
-            background: Some(&self.lighting.background),
+            ambient: Some(&l.ambient),
+            specular_ambient: Some(&l.specular),
+            background: Some(&l.background),
         };
         // paper 001's half resolution where the size halves evenly (a window can be any size)
         let (w, h) = self.size();

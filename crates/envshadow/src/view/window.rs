@@ -55,8 +55,9 @@ struct Live {
     gpu: Gpu,
     session: Session,
     display: Display,
-    /// Whether the surface's images can be copied (the screenshot is then what was shown).
-    copyable: bool,
+    /// The display pass into a texture that can be copied, for screenshots where the
+    /// surface's images cannot be (`None` where they can: the screenshot is what was shown).
+    fallback: Option<Display>,
 }
 
 #[derive(Default)]
@@ -164,7 +165,8 @@ impl App<'_> {
         (content.scene.camera.width, content.scene.camera.height) = (config.width, config.height);
         let session = Session::new(&gpu, content, self.technique, self.args)?;
         let display = Display::new(&gpu, format);
-        Ok(Live { window, instance, surface, config, gpu, session, display, copyable })
+        let fallback = (!copyable).then(|| Display::new(&gpu, super::OFFSCREEN_FORMAT));
+        Ok(Live { window, instance, surface, config, gpu, session, display, fallback })
     }
 
     /// One frame: the previous one read, this one recorded, shown, and on the last scripted
@@ -227,15 +229,18 @@ impl App<'_> {
         let last = self.args.frames.is_some_and(|n| k + 1 >= n);
         let mut shot = None;
         if (last && self.args.screenshot.is_some()) || std::mem::take(&mut self.shot_asked) {
-            shot = Some(if live.copyable {
-                (PendingShot::record(&live.gpu, &mut encoder, &surface.texture).map_err(|e| e.to_string())?, "window")
-            } else {
-                // the same pass into a texture that can be copied
-                let t = super::display::offscreen_target(&live.gpu, size, super::OFFSCREEN_FORMAT);
-                let offscreen = Display::new(&live.gpu, super::OFFSCREEN_FORMAT);
-                let view = t.create_view(&wgpu::TextureViewDescriptor::default());
-                offscreen.record(&live.gpu, &mut encoder, &frame.texture, live.session.stage.exposure(), &view);
-                (PendingShot::record(&live.gpu, &mut encoder, &t).map_err(|e| e.to_string())?, "offscreen")
+            shot = Some(match &live.fallback {
+                None => (
+                    PendingShot::record(&live.gpu, &mut encoder, &surface.texture).map_err(|e| e.to_string())?,
+                    "window",
+                ),
+                Some(offscreen) => {
+                    // the same pass into a texture that can be copied
+                    let t = super::display::offscreen_target(&live.gpu, size, super::OFFSCREEN_FORMAT);
+                    let view = t.create_view(&wgpu::TextureViewDescriptor::default());
+                    offscreen.record(&live.gpu, &mut encoder, &frame.texture, live.session.stage.exposure(), &view);
+                    (PendingShot::record(&live.gpu, &mut encoder, &t).map_err(|e| e.to_string())?, "offscreen")
+                }
             });
         }
         live.session.cpu.push(start.elapsed());
