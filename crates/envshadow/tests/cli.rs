@@ -648,6 +648,7 @@ fn view_in_a_window_shows_the_offscreen_frame_and_a_bad_dropped_file_leaves_it_r
             "--screenshot",
             shot.to_str().unwrap_or_default(),
             "--json",
+            "--no-panel",
         ]
         .map(String::from)
         .to_vec()
@@ -687,6 +688,66 @@ fn view_in_a_window_shows_the_offscreen_frame_and_a_bad_dropped_file_leaves_it_r
     // own conversion room
     let flip = ref_tracer::metrics::flip_rgb8(&b, &a, w, h);
     assert!(flip <= 0.01, "FLIP {flip} between the window and the offscreen frame");
+    // with its panel, and the difference from a reference: the window as shown, panel included
+    let panel = dir.join("panel.png");
+    let mut args = common(&panel);
+    args.retain(|a| a != "--no-panel");
+    if let Some(k) = args.iter().position(|a| a == "96x64") {
+        args[k] = "320x240".into();
+    }
+    args.extend(["--reference", "8", "--show", "difference"].map(String::from));
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let shown = view_json(&view_in_xvfb(&args));
+    assert_eq!(shown["reference"]["spp"], 8, "{shown}");
+    let ((w, h), c) = png_rgb(&panel);
+    assert_eq!((w, h), (320, 240));
+    // the panel's text: many pixels near white, which the frame under a white-grey exposure
+    // does not reach in a difference view (dimmed to a quarter)
+    let bright = c.iter().filter(|p| p.iter().all(|v| *v > 180)).count();
+    assert!(bright > 200, "{bright} bright pixels: no panel drawn?");
+}
+
+#[test]
+fn view_measures_its_frame_against_a_reference_and_shadows_bring_it_closer() {
+    let dir = fresh_dir("cli-view-reference");
+    let run = |technique: &str, diff: &Path| {
+        let out = envshadow(&[
+            "view",
+            "--offscreen",
+            "--frames",
+            "2",
+            "--size",
+            "64x48",
+            "--lights",
+            "16",
+            "--technique",
+            technique,
+            "--reference",
+            "64",
+            "--difference",
+            diff.to_str().unwrap_or_default(),
+            "--json",
+        ]);
+        view_json(&out)
+    };
+    let (shadowed, flat) = (run("paper001", &dir.join("a.png")), run("none", &dir.join("b.png")));
+    let r = &shadowed["reference"];
+    for key in ["spp", "seconds", "noise_rmse", "rmse", "rmse_without_noise", "flip", "reached_rmse", "reached_flip"] {
+        assert!(r.get(key).is_some(), "no reference.{key}: {shadowed}");
+    }
+    assert_eq!(r["spp"], 64);
+    let e = |j: &serde_json::Value, k: &str| j["reference"][k].as_f64().unwrap_or(f64::NAN);
+    assert!(e(&shadowed, "rmse_without_noise") <= e(&shadowed, "rmse"));
+    // the same lights unshadowed are farther from the truth, in RMSE and FLIP
+    assert!(e(&shadowed, "rmse_without_noise") < e(&flat, "rmse_without_noise"), "{shadowed}\n{flat}");
+    assert!(e(&shadowed, "flip") < e(&flat, "flip"), "{shadowed}\n{flat}");
+    // the unshadowed frame is reached sooner than the shadowed one, if at all
+    let reached = |j: &serde_json::Value| j["reference"]["reached_rmse"]["spp"].as_u64().unwrap_or(u64::MAX);
+    assert!(reached(&flat) <= reached(&shadowed), "{shadowed}\n{flat}");
+    let (size, a) = png_rgb(&dir.join("a.png"));
+    let (_, b) = png_rgb(&dir.join("b.png"));
+    assert_eq!(size, (64, 48));
+    assert!(a != b, "the two differences are one image");
 }
 
 #[test]
@@ -700,6 +761,8 @@ fn view_refuses_bad_arguments_and_files_in_one_line() {
         vec!["view", "--offscreen", "--frames", "1", "--lights", "0"],
         vec!["view", "--offscreen", "--frames", "1", "--envmap", m],
         vec!["view", "--offscreen", "--frames", "1", "--scene", "nowhere.glb"],
+        vec!["view", "--offscreen", "--frames", "1", "--reference", "1"],
+        vec!["view", "--offscreen", "--frames", "1", "--show", "truth"],
     ] {
         let out = envshadow(&args);
         assert_eq!(out.status.code(), Some(1), "{args:?}");

@@ -37,5 +37,5 @@ pub mod visibility;
 pub use bvh::{BvhQuality, SceneBvh, SurfacePoint};
 pub use emitters::Emitters;
 pub use integrator::{AmbientMap, EnvLight, Integrator, LightSet, Strategy};
-pub use render::{Render, RenderSettings, render};
+pub use render::{Progressive, Render, RenderSettings, render};
 pub use sampler::SamplerKind;

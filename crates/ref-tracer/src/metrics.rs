@@ -41,6 +41,9 @@ pub fn relative_mse(reference: &[Vec3], test: &[Vec3]) -> f64 {
     })
 }
 
+/// The viewing distance FLIP assumes, in pixels per degree (FLIP's default).
+pub const FLIP_PIXELS_PER_DEGREE: f32 = nv_flip::DEFAULT_PIXELS_PER_DEGREE;
+
 /// The tone mapping applied to both images before LDR-FLIP.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FlipTonemap {

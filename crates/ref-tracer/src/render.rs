@@ -7,6 +7,7 @@ use crate::sampler::{PixelSampler, SamplerKind};
 use glam::Vec3;
 use rayon::prelude::*;
 use scene::Scene;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 const TILE: u32 = 16;
@@ -65,36 +66,55 @@ pub struct Render {
     pub seconds: f64,
 }
 
-/// Renders `scene` with `integrator`. `progress` is called after each pass with
-/// (samples done, samples planned) per pixel.
-#[must_use]
-pub fn render(
-    scene: &Scene,
-    bvh: &SceneBvh,
-    env: Option<&EnvLight>,
-    integrator: &Integrator,
-    settings: &RenderSettings,
-    progress: &(dyn Fn(u32, u32) + Sync),
-) -> Render {
-    debug_assert!(
-        !(matches!(integrator, Integrator::EnvDirect(Strategy::EnvOnly)) && env.is_some_and(|e| !e.dist.is_complete())),
-        "map-only sampling needs the complete distribution (EnvLight::for_strategy)"
-    );
-    let (w, h) = (scene.camera.width, scene.camera.height);
-    let cam = scene.camera.rays();
-    let n = (w * h) as usize;
-    let start = Instant::now();
-    let tiles: Vec<(u32, u32)> =
-        (0..h.div_ceil(TILE)).flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE))).collect();
-    let mut sum = vec![Vec3::ZERO; n];
-    // with a time budget a pass is one sample, so the budget is overshot by one pass at most
-    let pass_size = if settings.time_budget.is_some() { 1 } else { (settings.spp / 16).max(1) };
-    let mut done = 0u32;
-    while done < settings.spp {
-        let count = pass_size.min(settings.spp - done);
+/// A render refined pass by pass: each pass adds samples to every pixel's sum, continuing one
+/// seed's sample sequence, so after n samples the image is the one [`render`] makes with n
+/// samples in the same passes (bit for bit). A pass can be cancelled between tiles (a viewer
+/// whose camera moved): the pass is then dropped whole and the image stays as it was.
+#[derive(Clone, Debug)]
+pub struct Progressive {
+    width: u32,
+    height: u32,
+    settings: RenderSettings,
+    sum: Vec<Vec3>,
+    done: u32,
+    seconds: f64,
+}
+
+impl Progressive {
+    /// No samples yet, for frames of `scene`'s camera size; `settings.spp` and `time_budget`
+    /// are not used (the caller decides how many passes).
+    #[must_use]
+    pub fn new(scene: &Scene, settings: &RenderSettings) -> Self {
+        let (width, height) = (scene.camera.width, scene.camera.height);
+        let n = width as usize * height as usize;
+        Self { width, height, settings: *settings, sum: vec![Vec3::ZERO; n], done: 0, seconds: 0.0 }
+    }
+
+    /// Adds `count` samples to every pixel of `scene` (the scene this was made for). Returns
+    /// false, adding nothing, when `cancel` was set during the pass.
+    pub fn pass(
+        &mut self,
+        scene: &Scene,
+        bvh: &SceneBvh,
+        env: Option<&EnvLight>,
+        integrator: &Integrator,
+        count: u32,
+        cancel: &AtomicBool,
+    ) -> bool {
+        let start = Instant::now();
+        let (w, h) = (self.width, self.height);
+        let cam = scene.camera.rays();
+        let settings = &self.settings;
+        let done = self.done;
+        let count = count.min(u32::MAX - done);
+        let tiles: Vec<(u32, u32)> =
+            (0..h.div_ceil(TILE)).flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE))).collect();
         let results: Vec<Vec<(usize, Vec3)>> = tiles
             .par_iter()
             .map(|&(x0, y0)| {
+                if cancel.load(Ordering::Relaxed) {
+                    return Vec::new();
+                }
                 let mut out = Vec::with_capacity((TILE * TILE) as usize);
                 for y in y0..(y0 + TILE).min(h) {
                     for x in x0..(x0 + TILE).min(w) {
@@ -116,17 +136,76 @@ pub fn render(
                 out
             })
             .collect();
-        for (pixel, acc) in results.into_iter().flatten() {
-            sum[pixel] += acc;
+        if cancel.load(Ordering::Relaxed) {
+            return false;
         }
-        done += count;
-        progress(done, settings.spp);
+        for (pixel, acc) in results.into_iter().flatten() {
+            self.sum[pixel] += acc;
+        }
+        self.done += count;
+        self.seconds += start.elapsed().as_secs_f64();
+        true
+    }
+
+    /// Samples per pixel so far.
+    #[must_use]
+    pub fn spp(&self) -> u32 {
+        self.done
+    }
+
+    /// Wall time of the passes that were kept.
+    #[must_use]
+    pub fn seconds(&self) -> f64 {
+        self.seconds
+    }
+
+    /// The image so far: each pixel's mean (black before the first pass).
+    #[must_use]
+    pub fn image(&self) -> Vec<Vec3> {
+        let n = self.done.max(1) as f32;
+        self.sum.iter().map(|s| *s / n).collect()
+    }
+
+    /// (width, height).
+    #[must_use]
+    pub fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+}
+
+/// Renders `scene` with `integrator`. `progress` is called after each pass with
+/// (samples done, samples planned) per pixel.
+#[must_use]
+pub fn render(
+    scene: &Scene,
+    bvh: &SceneBvh,
+    env: Option<&EnvLight>,
+    integrator: &Integrator,
+    settings: &RenderSettings,
+    progress: &(dyn Fn(u32, u32) + Sync),
+) -> Render {
+    debug_assert!(
+        !(matches!(integrator, Integrator::EnvDirect(Strategy::EnvOnly)) && env.is_some_and(|e| !e.dist.is_complete())),
+        "map-only sampling needs the complete distribution (EnvLight::for_strategy)"
+    );
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    let cam = scene.camera.rays();
+    let n = (w * h) as usize;
+    let start = Instant::now();
+    let mut image = Progressive::new(scene, settings);
+    let never = AtomicBool::new(false);
+    // with a time budget a pass is one sample, so the budget is overshot by one pass at most
+    let pass_size = if settings.time_budget.is_some() { 1 } else { (settings.spp / 16).max(1) };
+    while image.spp() < settings.spp {
+        let count = pass_size.min(settings.spp - image.spp());
+        image.pass(scene, bvh, env, integrator, count, &never);
+        progress(image.spp(), settings.spp);
         if settings.time_budget.is_some_and(|b| start.elapsed() >= b) {
             break;
         }
     }
+    let (color, done) = (image.image(), image.spp());
     let seconds = start.elapsed().as_secs_f64();
-    let color = sum.into_iter().map(|s| s / done as f32).collect();
     let mut r = Render {
         width: w,
         height: h,

@@ -4,7 +4,8 @@
 use envmap_sphere::{EnvMap, Sh9};
 use glam::Vec3;
 use ref_tracer::{
-    EnvLight, Integrator, LightSet, Render, RenderSettings, SamplerKind, SceneBvh, Strategy, metrics, render,
+    EnvLight, Integrator, LightSet, Progressive, Render, RenderSettings, SamplerKind, SceneBvh, Strategy, metrics,
+    render,
 };
 use scene::{Camera, DistantLight, Material, Mesh, Object, Scene};
 
@@ -440,6 +441,44 @@ fn images_are_identical_for_any_thread_count() {
         })
         .collect();
     assert!(images.windows(2).all(|w| w[0] == w[1]));
+}
+
+#[test]
+fn a_progressive_render_is_the_render_of_its_samples_and_a_cancelled_pass_adds_nothing() {
+    use std::sync::atomic::AtomicBool;
+    let scene = small("spheres_box", 40, 30);
+    let map = envmap_sphere::default_map().resize(256, 128);
+    let integrator = Integrator::EnvDirect(Strategy::Mis);
+    let settings = RenderSettings { spp: 8, seed: 5, aovs: false, ..RenderSettings::default() };
+    let whole = run_with(&scene, Some(&map), &integrator, &settings);
+    let (bvh, env) = (SceneBvh::new(&scene), EnvLight::new(&map));
+    let go = AtomicBool::new(false);
+    // render's passes for 8 spp are one sample each: the same sums in the same order
+    let mut one = Progressive::new(&scene, &settings);
+    for _ in 0..8 {
+        assert!(one.pass(&scene, &bvh, Some(&env), &integrator, 1, &go));
+    }
+    assert_eq!(one.spp(), 8);
+    assert!(one.image() == whole.color, "one sample a pass differs from render's passes");
+    // other passes: the same samples, summed in another grouping
+    let mut two = Progressive::new(&scene, &settings);
+    for count in [3, 5] {
+        assert!(two.pass(&scene, &bvh, Some(&env), &integrator, count, &go));
+    }
+    let worst = two
+        .image()
+        .iter()
+        .zip(&whole.color)
+        .map(|(a, b)| ((*a - *b).abs() / b.max(Vec3::splat(1e-3))).max_element())
+        .fold(0.0f32, f32::max);
+    assert!(worst < 1e-5, "passes of 3 and 5 samples differ by {worst} (relative)");
+    // a pass cancelled (before any tile ran) adds nothing
+    let before = two.image();
+    let stop = AtomicBool::new(true);
+    assert!(!two.pass(&scene, &bvh, Some(&env), &integrator, 4, &stop));
+    assert_eq!(two.spp(), 8);
+    assert!(two.image() == before);
+    assert!(Progressive::new(&scene, &settings).image().iter().all(|p| *p == Vec3::ZERO));
 }
 
 #[test]

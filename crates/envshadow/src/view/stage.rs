@@ -49,16 +49,12 @@ impl ViewTechnique {
     /// # Errors
     /// An unknown name, listing the known ones.
     pub(crate) fn parse(name: &str) -> Result<Self, String> {
-        Self::ALL.into_iter().find(|t| t.name() == name).ok_or_else(|| {
-            let known: Vec<&str> = Self::ALL.iter().map(|t| t.name()).collect();
-            format!("unknown technique {name:?}; known: {}", known.join(", "))
-        })
+        super::named(&Self::ALL, Self::name, "technique", name)
     }
 
     /// The next one in [`ViewTechnique::ALL`].
     pub(crate) fn next(self) -> Self {
-        let k = Self::ALL.iter().position(|&t| t == self).unwrap_or(0);
-        Self::ALL[(k + 1) % Self::ALL.len()]
+        super::after(&Self::ALL, self)
     }
 }
 
@@ -255,6 +251,11 @@ impl Stage {
     /// The moving object's name, if the scene has one besides its ground.
     pub(crate) fn moving_object(&self) -> Option<&str> {
         self.content.moving.map(|k| self.content.scene.objects[k].name.as_str())
+    }
+
+    /// The moving object's index in the scene.
+    pub(crate) fn moving_index(&self) -> Option<usize> {
+        self.content.moving
     }
 
     /// The moving object's offset on the ground from its rest pose.

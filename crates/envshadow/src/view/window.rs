@@ -3,16 +3,23 @@
 //! the input.
 //!
 //! Keys: `T` the next technique, `+` / `-` twice or half the lights, `Q` / `E` turn the map,
-//! arrows (or W A S D) move the scene's object on the ground, `P` saves a screenshot, `Esc`
-//! quits. Mouse: left drag
-//! orbits, right drag (or shift + left) pans, the wheel zooms, ctrl + left drag moves the object.
-//! Files dropped on the window load: a map or a model.
+//! arrows (or W A S D) move the scene's object on the ground, `R` shows the frame, the reference
+//! or their difference, `H` hides the panel, `P` saves a screenshot, `Esc` quits. Mouse: left
+//! drag orbits, right drag (or shift + left) pans, the wheel zooms, ctrl + left drag moves the
+//! object. Files dropped on the window load: a map or a model.
+//!
+//! A frame is drawn when something changed. While nothing does, the view is still: the reference
+//! tracer refines its reference in the background ([`super::reference`]), the frame shown is
+//! measured against it, and the window redraws (the display pass and the panel, not the frame)
+//! when the reference has something new. Scripted runs (`--frames`) draw every frame.
 
-use super::display::{Display, PendingShot};
-use super::{Content, Session, ViewArgs, ViewTechnique, finish_run};
+use super::display::{Display, PendingShot, Shown};
+use super::panel::{Facts, Panel};
+use super::reference::{Progress, Reference};
+use super::{Content, FrameStamps, LIVE_REFERENCE_SPP, Session, ViewArgs, ViewTechnique, finish_run};
 use gpu::Gpu;
 use std::sync::Arc;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
@@ -27,7 +34,9 @@ use winit::window::{Window, WindowId};
 pub(crate) fn run(content: Content, technique: ViewTechnique, args: &ViewArgs) -> Result<(), String> {
     let event_loop = EventLoop::new()
         .map_err(|e| format!("cannot open a window: {e} (no display? run under xvfb-run, or add --offscreen)"))?;
-    event_loop.set_control_flow(ControlFlow::Poll);
+    // scripted runs draw frame after frame; the window waits for input, and looks at the
+    // background reference a few times a second
+    event_loop.set_control_flow(if args.frames.is_some() { ControlFlow::Poll } else { ControlFlow::Wait });
     let mut app = App {
         args,
         technique,
@@ -36,6 +45,10 @@ pub(crate) fn run(content: Content, technique: ViewTechnique, args: &ViewArgs) -
         error: None,
         in_flight: None,
         started: None,
+        shown_id: None,
+        measured: None,
+        progress: None,
+        uploaded: None,
         drag: Drag::default(),
         modifiers: ModifiersState::empty(),
         shot_asked: false,
@@ -58,6 +71,10 @@ struct Live {
     /// The display pass into a texture that can be copied, for screenshots where the
     /// surface's images cannot be (`None` where they can: the screenshot is what was shown).
     fallback: Option<Display>,
+    panel: Panel,
+    reference: Reference,
+    /// The reference uploaded for the display, and its generation.
+    reference_texture: Option<wgpu::Texture>,
 }
 
 #[derive(Default)]
@@ -74,9 +91,16 @@ struct App<'a> {
     live: Option<Live>,
     error: Option<String>,
     /// The frame submitted last, read once the next one starts (one frame in flight).
-    in_flight: Option<gpu::RenderedFrame>,
+    in_flight: Option<(gpu::RenderedFrame, FrameStamps)>,
     /// When the last frame started.
     started: Option<Instant>,
+    /// The frame drawn last (its view, technique and lights), and the one measured last.
+    shown_id: Option<u64>,
+    measured: Option<u64>,
+    /// The reference of the view shown, as the panel and display show it.
+    progress: Option<Progress>,
+    /// The generation of the reference uploaded for the display.
+    uploaded: Option<u64>,
     drag: Drag,
     modifiers: ModifiersState,
     /// The `P` key was pressed: the next frame is saved.
@@ -166,23 +190,40 @@ impl App<'_> {
         let session = Session::new(&gpu, content, self.technique, self.args)?;
         let display = Display::new(&gpu, format);
         let fallback = (!copyable).then(|| Display::new(&gpu, super::OFFSCREEN_FORMAT));
-        Ok(Live { window, instance, surface, config, gpu, session, display, fallback })
+        let mut panel = Panel::new(&gpu, &window, format);
+        panel.visible = !self.args.no_panel;
+        let reference = Reference::new();
+        Ok(Live {
+            window,
+            instance,
+            surface,
+            config,
+            gpu,
+            session,
+            display,
+            fallback,
+            panel,
+            reference,
+            reference_texture: None,
+        })
     }
 
-    /// One frame: the previous one read, this one recorded, shown, and on the last scripted
-    /// frame the screenshot and the JSON.
+    /// One frame: the previous one read; this one recorded where something changed (every
+    /// frame of a scripted run), else the reference refined and the frame measured; shown with
+    /// the panel; on the last scripted frame the reference asked for, the screenshot and the
+    /// JSON.
     fn frame(&mut self, event_loop: &ActiveEventLoop) -> Result<(), String> {
         let Some(live) = self.live.as_mut() else { return Ok(()) };
         let start = Instant::now();
+        let scripted = self.args.frames.is_some();
         // one frame in flight: the previous one's work waited for, its reports read
-        if let Some(previous) = self.in_flight.take() {
+        if let Some((previous, stamps)) = self.in_flight.take() {
             live.gpu.wait(None).map_err(|e| e.to_string())?;
             live.session.finish(&live.gpu, previous)?;
+            live.session.gpu_times.extend(stamps.read(&live.gpu));
         }
-        if let Some(t) = self.started.replace(start) {
-            live.session.times.push(start - t);
-        }
-        let k = live.session.times.len();
+        // frames drawn so far
+        let k = live.session.cpu.len();
         if k >= 1
             && !self.dropped
             && let Some(p) = &self.args.drop
@@ -190,7 +231,7 @@ impl App<'_> {
             self.dropped = true;
             let _ = live.session.load(&live.gpu, p);
         }
-        if k > 0 {
+        if k > 0 && scripted {
             live.session.orbit.rotate(self.args.orbit.to_radians(), 0.0);
         }
         let surface = match live.surface.get_current_texture() {
@@ -222,11 +263,96 @@ impl App<'_> {
         let size = (surface.texture.width(), surface.texture.height());
         live.session.stage.resize(&live.gpu, size)?;
         let camera = live.session.camera();
-        let frame = live.session.stage.render(&live.gpu, &camera).map_err(|e| e.to_string())?;
+        let key = live.session.view_key(&camera);
+        let id = live.session.frame_id(&camera);
+        let changed = scripted || self.shown_id != Some(id) || live.session.last_texture.is_none();
+        let frame_texture = if changed {
+            // the view moved: the reference of the old one is of no use
+            if live.reference.key().is_some_and(|r| r != key) {
+                live.reference.want(None);
+                self.progress = None;
+            }
+            if let Some(t) = self.started.replace(start) {
+                live.session.times.push(start - t);
+            }
+            let stamps = FrameStamps::begin(&live.gpu);
+            let frame = live.session.stage.render(&live.gpu, &camera).map_err(|e| e.to_string())?;
+            let texture = frame.texture.clone();
+            self.in_flight = Some((frame, stamps));
+            self.shown_id = Some(id);
+            texture
+        } else {
+            // still: refine the view's reference, and measure the frame shown (it has finished)
+            if live.reference.key() != Some(key) {
+                live.reference.want(Some(live.session.job(&camera, LIVE_REFERENCE_SPP)));
+            }
+            let texture = live.session.last_texture.clone().ok_or("no frame to show")?;
+            if self.measured != Some(id) {
+                self.measured = Some(id);
+                live.reference.measure(id, gpu::read_hdr(&live.gpu, &texture).map_err(|e| e.to_string())?);
+            }
+            self.progress = live.reference.progress().filter(|p| p.key == key);
+            texture
+        };
+        let last = self.args.frames.is_some_and(|n| k + 1 >= n);
+        if last {
+            // the last scripted frame: finished here, then its reference if asked
+            live.gpu.wait(None).map_err(|e| e.to_string())?;
+            // (its GPU time is not read: its end stamp would be in the display's encoder; its
+            // times end here, the reference's apart)
+            live.session.cpu.push(start.elapsed());
+            if let Some((frame, _)) = self.in_flight.take() {
+                live.session.finish(&live.gpu, frame)?;
+            }
+            live.session.times.push(start.elapsed());
+            if let Some(spp) = self.args.reference {
+                self.progress = live.session.converge(&live.gpu, spp)?;
+            }
+        }
+        // the reference for the display, uploaded when it has something new
+        let reference_shown = live.session.shown != Shown::Frame;
+        match &self.progress {
+            Some(p) if reference_shown && self.uploaded != Some(p.generation) => {
+                live.reference_texture =
+                    Some(super::display::upload_hdr(&live.gpu, size, &p.image).map_err(|e| e.to_string())?);
+                self.uploaded = Some(p.generation);
+            }
+            None => {
+                live.reference_texture = None;
+                self.uploaded = None;
+            }
+            _ => {}
+        }
+        let shown = (live.session.shown, live.reference_texture.as_ref().filter(|_| self.progress.is_some()));
         let target = surface.texture.create_view(&wgpu::TextureViewDescriptor::default());
         let mut encoder = live.gpu.encoder("display");
-        live.display.record(&live.gpu, &mut encoder, &frame.texture, live.session.stage.exposure(), &target);
-        let last = self.args.frames.is_some_and(|n| k + 1 >= n);
+        let exposure = live.session.stage.exposure();
+        live.display.record(&live.gpu, &mut encoder, &frame_texture, exposure, &target, shown);
+        let asked = {
+            let s = &live.session;
+            let ms = |d: Option<&Duration>| d.map(|d| d.as_secs_f64() * 1e3);
+            let message = s.messages.last().map(String::as_str);
+            let facts = Facts {
+                adapter: &s.adapter,
+                size,
+                gpu_ms: ms(s.gpu_times.last()),
+                cpu_ms: ms(s.cpu.last()),
+                frame_ms: ms(s.times.last()),
+                technique: s.stage.technique,
+                lights: s.stage.lights,
+                shadowed: s.shadowed,
+                skipped: &s.skipped,
+                turn_degrees: s.stage.turn().to_degrees(),
+                scene: &s.scene_name,
+                triangles: s.stage.scene().triangle_count(),
+                reference: self.progress.as_ref(),
+                frame: id,
+                still: !changed,
+                message,
+                shown: s.shown,
+            };
+            live.panel.record(&live.gpu, &mut encoder, &live.window, &target, size, &facts)
+        };
         let mut shot = None;
         if (last && self.args.screenshot.is_some()) || std::mem::take(&mut self.shot_asked) {
             shot = Some(match &live.fallback {
@@ -235,27 +361,34 @@ impl App<'_> {
                     "window",
                 ),
                 Some(offscreen) => {
-                    // the same pass into a texture that can be copied
+                    // the same pass into a texture that can be copied (without the panel)
                     let t = super::display::offscreen_target(&live.gpu, size, super::OFFSCREEN_FORMAT);
                     let view = t.create_view(&wgpu::TextureViewDescriptor::default());
-                    offscreen.record(&live.gpu, &mut encoder, &frame.texture, live.session.stage.exposure(), &view);
+                    offscreen.record(&live.gpu, &mut encoder, &frame_texture, exposure, &view, shown);
                     (PendingShot::record(&live.gpu, &mut encoder, &t).map_err(|e| e.to_string())?, "offscreen")
                 }
             });
         }
-        live.session.cpu.push(start.elapsed());
+        if let Some((_, stamps)) = &self.in_flight {
+            stamps.end(&mut encoder);
+        }
+        if changed && !last {
+            live.session.cpu.push(start.elapsed());
+        }
         live.gpu.submit(encoder);
         live.window.pre_present_notify();
         live.gpu.queue.present(surface);
-        self.in_flight = Some(frame);
         if last {
             live.gpu.wait(None).map_err(|e| e.to_string())?;
-            if let Some(frame) = self.in_flight.take() {
-                live.session.finish(&live.gpu, frame)?;
-            }
-            live.session.times.push(start.elapsed());
             let from = shot.as_ref().map_or("", |s| s.1);
-            finish_run(&live.gpu, &live.session, self.args, shot.map(|s| s.0), from)?;
+            let reference = live.reference_texture.clone().filter(|_| self.args.reference.is_some());
+            let reference = match (&reference, &self.progress) {
+                (None, Some(p)) if self.args.difference.is_some() => {
+                    Some(super::display::upload_hdr(&live.gpu, size, &p.image).map_err(|e| e.to_string())?)
+                }
+                _ => reference,
+            };
+            finish_run(&live.gpu, &live.session, self.args, shot.map(|s| s.0), from, reference.as_ref())?;
             event_loop.exit();
             return Ok(());
         }
@@ -269,18 +402,39 @@ impl App<'_> {
                 Err(e) => eprintln!("screenshot not saved: {e}"),
             }
         }
+        self.apply(&asked);
+        let Some(live) = self.live.as_mut() else { return Ok(()) };
         let s = &live.session;
-        let ms = s.times.last().map_or(0.0, |d| d.as_secs_f64() * 1e3);
         live.window.set_title(&format!(
-            "envshadow: {} ({} lights, {} shadowed) {:.0} ms{}",
+            "envshadow: {} ({} lights, {} shadowed){}",
             s.stage.technique.name(),
             s.stage.lights,
             s.shadowed,
-            ms,
             s.messages.last().map_or(String::new(), |m| format!(" | {m}"))
         ));
-        live.window.request_redraw();
+        // a drawn frame asks for the next (a still view is noticed there); a still one waits
+        if changed || scripted {
+            live.window.request_redraw();
+        }
         Ok(())
+    }
+
+    /// What the panel's controls asked for.
+    fn apply(&mut self, asked: &super::panel::Asked) {
+        let Some(live) = self.live.as_mut() else { return };
+        let s = &mut live.session;
+        if let Some(t) = asked.technique {
+            s.stage.technique = t;
+        }
+        if let Some(n) = asked.lights {
+            set_lights(s, &live.gpu, n);
+        }
+        if let Some(shown) = asked.shown {
+            s.shown = shown;
+        }
+        if asked.technique.is_some() || asked.lights.is_some() || asked.shown.is_some() {
+            live.window.request_redraw();
+        }
     }
 
     fn key(&mut self, key: &Key) -> Result<(), String> {
@@ -305,6 +459,8 @@ impl App<'_> {
                 "+" | "=" => set_lights(s, gpu, (s.stage.lights * 2).min(super::MAX_LIGHTS)),
                 "-" => set_lights(s, gpu, (s.stage.lights / 2).max(1)),
                 "p" | "P" => self.shot_asked = true,
+                "r" | "R" => s.shown = s.shown.next(),
+                "h" | "H" => live.panel.visible = !live.panel.visible,
                 _ => {}
             },
             _ => {}
@@ -353,7 +509,41 @@ impl ApplicationHandler for App<'_> {
         }
     }
 
+    fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
+        let Some(live) = self.live.as_ref() else { return };
+        if self.args.frames.is_some() {
+            return;
+        }
+        // a still view's reference has something new: show it
+        if let Some(p) = live.reference.progress()
+            && self.progress.as_ref().is_none_or(|q| q.generation != p.generation)
+            && self.measured.is_some()
+        {
+            live.window.request_redraw();
+        }
+        let wake = if live.reference.key().is_some() { Duration::from_millis(250) } else { Duration::from_secs(1) };
+        event_loop.set_control_flow(ControlFlow::WaitUntil(Instant::now() + wake));
+    }
+
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
+        let input = matches!(
+            event,
+            WindowEvent::KeyboardInput { .. }
+                | WindowEvent::MouseInput { .. }
+                | WindowEvent::CursorMoved { .. }
+                | WindowEvent::MouseWheel { .. }
+                | WindowEvent::ModifiersChanged(_)
+        );
+        if let Some(live) = self.live.as_mut() {
+            if input || matches!(event, WindowEvent::Resized(_) | WindowEvent::DroppedFile(_)) {
+                live.window.request_redraw();
+            }
+            // what the panel takes (a click on a button) is not the view's; a release always is
+            let release = matches!(event, WindowEvent::MouseInput { state: ElementState::Released, .. });
+            if input && live.panel.on_event(&live.window, &event) && !release {
+                return;
+            }
+        }
         let r = match event {
             WindowEvent::CloseRequested => {
                 event_loop.exit();
