@@ -708,6 +708,34 @@ fn view_in_a_window_shows_the_offscreen_frame_and_a_bad_dropped_file_leaves_it_r
 }
 
 #[test]
+fn view_held_still_refines_its_reference_in_the_background_and_measures_the_frame() {
+    let dir = fresh_dir("cli-view-hold");
+    let (held, plain) = (dir.join("held.png"), dir.join("plain.png"));
+    let run = |shot: &Path, hold: &[&str]| {
+        let mut args = vec!["--size", "64x48", "--lights", "8", "--frames", "2", "--no-panel", "--json"];
+        args.extend(["--screenshot", shot.to_str().unwrap_or_default()]);
+        args.extend(hold);
+        view_json(&view_in_xvfb(&args))
+    };
+    // the window's own path: the frames done, the view still, the thread refining, the frame
+    // read back and measured, the difference shown
+    let j = run(&held, &["--hold", "6", "--show", "difference"]);
+    let live = &j["live_reference"];
+    assert_eq!(j["frames"], 2, "{j}");
+    assert!(live["spp"].as_u64().is_some_and(|n| n >= 4), "{j}");
+    let f = |k: &str| live[k].as_f64().unwrap_or(f64::NAN);
+    assert!(f("rmse") > 0.0 && f("rmse_without_noise") <= f("rmse"), "{j}");
+    assert!(f("flip") > 0.0 && f("flip") < 1.0, "{j}");
+    assert!(f("noise_rmse") > 0.0 && f("noise_rmse") < f("rmse"), "{j}");
+    let plain_json = run(&plain, &[]);
+    assert!(plain_json["live_reference"].is_null());
+    let ((w, h), a) = png_rgb(&held);
+    let (_, b) = png_rgb(&plain);
+    assert_eq!((w, h), (64, 48));
+    assert!(a != b, "the held window does not show the difference");
+}
+
+#[test]
 fn view_measures_its_frame_against_a_reference_and_shadows_bring_it_closer() {
     let dir = fresh_dir("cli-view-reference");
     let run = |technique: &str, diff: &Path| {
@@ -763,6 +791,8 @@ fn view_refuses_bad_arguments_and_files_in_one_line() {
         vec!["view", "--offscreen", "--frames", "1", "--scene", "nowhere.glb"],
         vec!["view", "--offscreen", "--frames", "1", "--reference", "1"],
         vec!["view", "--offscreen", "--frames", "1", "--show", "truth"],
+        vec!["view", "--offscreen", "--frames", "1", "--hold", "2"],
+        vec!["view", "--frames", "1", "--hold", "nan"],
     ] {
         let out = envshadow(&args);
         assert_eq!(out.status.code(), Some(1), "{args:?}");

@@ -84,6 +84,11 @@ pub(crate) struct ViewArgs {
     /// With --reference: save the difference view (frame against reference) as this PNG.
     #[arg(long, requires = "reference")]
     pub difference: Option<PathBuf>,
+    /// After the frames, keep the window's view still this many seconds (its background
+    /// reference refining, the frame measured against it) before the screenshot; the JSON's
+    /// `live_reference` is what it reached.
+    #[arg(long, requires = "frames")]
+    pub hold: Option<f32>,
     /// No panel over the window's view (`H` toggles it).
     #[arg(long)]
     pub no_panel: bool,
@@ -127,6 +132,14 @@ pub(crate) fn run(args: &ViewArgs) -> Result<(), String> {
         return Err(format!("--reference {spp}: give 2 to {MAX_REFERENCE_SPP} samples per pixel"));
     }
     Shown::parse(&args.show)?;
+    if let Some(h) = args.hold
+        && !(h.is_finite() && (0.0..=3600.0).contains(&h))
+    {
+        return Err(format!("--hold {h}: give 0 to 3600 seconds"));
+    }
+    if args.hold.is_some() && args.offscreen {
+        return Err("--hold is the window's: it has no background reference offscreen".into());
+    }
     if args.size.0 == 0 || args.size.1 == 0 || args.size.0 > 16384 || args.size.1 > 16384 {
         return Err(format!("--size {}x{}: give 1 to 16384 a side", args.size.0, args.size.1));
     }
@@ -180,6 +193,8 @@ pub(crate) struct Session {
     shown: Shown,
     /// A scripted run's reference (`--reference`).
     converged: Option<reference::Converged>,
+    /// The window's background reference at the end of `--hold`.
+    live_reference: Option<reference::Progress>,
     /// Scene, map and GPU set-up.
     setup: Duration,
     /// Dropped files that could not be loaded, one line each.
@@ -210,6 +225,7 @@ impl Session {
             last_texture: None,
             shown: Shown::parse(&args.show)?,
             converged: None,
+            live_reference: None,
             setup: content.loaded + t.elapsed(),
             messages: Vec::new(),
             shadowed: 0,
@@ -380,6 +396,18 @@ impl Session {
             "screenshot_from": screenshot.map(|(_, from)| from),
             "messages": self.messages,
             "reference": reference,
+            "live_reference": self.live_reference.as_ref().map(|p| {
+                let e = p.error.as_ref();
+                serde_json::json!({
+                    "spp": p.spp,
+                    "seconds": p.seconds,
+                    "noise_rmse": p.noise,
+                    "rmse": e.map(|e| e.rmse),
+                    "rmse_without_noise": e.map(|e| e.rmse_truth),
+                    "flip": e.map(|e| e.flip),
+                    "passed": e.and_then(|e| e.passed).map(|(s, spp)| serde_json::json!({"seconds": s, "spp": spp})),
+                })
+            }),
         })
     }
 

@@ -46,6 +46,7 @@ pub(crate) fn run(content: Content, technique: ViewTechnique, args: &ViewArgs) -
         in_flight: None,
         started: None,
         shown_id: None,
+        hold_until: None,
         measured: None,
         progress: None,
         uploaded: None,
@@ -96,6 +97,8 @@ struct App<'a> {
     started: Option<Instant>,
     /// The frame drawn last (its view, technique and lights), and the one measured last.
     shown_id: Option<u64>,
+    /// `--hold`: the scripted frames are done, the view is held still until then.
+    hold_until: Option<Instant>,
     measured: Option<u64>,
     /// The reference of the view shown, as the panel and display show it.
     progress: Option<Progress>,
@@ -215,12 +218,19 @@ impl App<'_> {
     fn frame(&mut self, event_loop: &ActiveEventLoop) -> Result<(), String> {
         let Some(live) = self.live.as_mut() else { return Ok(()) };
         let start = Instant::now();
-        let scripted = self.args.frames.is_some();
+        let holding = self.hold_until;
+        let scripted = self.args.frames.is_some() && holding.is_none();
         // one frame in flight: the previous one's work waited for, its reports read
         if let Some((previous, stamps)) = self.in_flight.take() {
             live.gpu.wait(None).map_err(|e| e.to_string())?;
             live.session.finish(&live.gpu, previous)?;
             live.session.gpu_times.extend(stamps.read(&live.gpu));
+            // the last scripted frame before --hold: from its start to here
+            if self.hold_until.is_some()
+                && let Some(t) = self.started
+            {
+                live.session.times.push(t.elapsed());
+            }
         }
         // frames drawn so far
         let k = live.session.cpu.len();
@@ -294,17 +304,29 @@ impl App<'_> {
             self.progress = live.reference.progress().filter(|p| p.key == key);
             texture
         };
-        let last = self.args.frames.is_some_and(|n| k + 1 >= n);
+        let mut last = self.args.frames.is_some_and(|n| k + 1 >= n);
+        if let Some(t) = holding {
+            last = start >= t;
+        } else if last && let Some(h) = self.args.hold {
+            // the frames are done: the view is held still from the next redraw on
+            self.hold_until = Some(start + Duration::from_secs_f32(h));
+            last = false;
+        }
         if last {
             // the last scripted frame: finished here, then its reference if asked
             live.gpu.wait(None).map_err(|e| e.to_string())?;
             // (its GPU time is not read: its end stamp would be in the display's encoder; its
             // times end here, the reference's apart)
-            live.session.cpu.push(start.elapsed());
+            if changed {
+                live.session.cpu.push(start.elapsed());
+            }
             if let Some((frame, _)) = self.in_flight.take() {
                 live.session.finish(&live.gpu, frame)?;
+                live.session.times.push(start.elapsed());
             }
-            live.session.times.push(start.elapsed());
+            if holding.is_some() {
+                live.session.live_reference.clone_from(&self.progress);
+            }
             if let Some(spp) = self.args.reference {
                 self.progress = live.session.converge(&live.gpu, spp)?;
             }
@@ -511,7 +533,7 @@ impl ApplicationHandler for App<'_> {
 
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
         let Some(live) = self.live.as_ref() else { return };
-        if self.args.frames.is_some() {
+        if self.args.frames.is_some() && self.hold_until.is_none() {
             return;
         }
         // a still view's reference has something new: show it
@@ -521,8 +543,17 @@ impl ApplicationHandler for App<'_> {
         {
             live.window.request_redraw();
         }
+        let now = Instant::now();
         let wake = if live.reference.key().is_some() { Duration::from_millis(250) } else { Duration::from_secs(1) };
-        event_loop.set_control_flow(ControlFlow::WaitUntil(Instant::now() + wake));
+        let mut until = now + wake;
+        if let Some(t) = self.hold_until {
+            // --hold's end: the last redraw
+            if now >= t {
+                live.window.request_redraw();
+            }
+            until = until.min(t);
+        }
+        event_loop.set_control_flow(ControlFlow::WaitUntil(until));
     }
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
