@@ -158,13 +158,10 @@ impl<'a> Running<'a> {
         self.halves.iter_mut().all(|h| h.pass(scene, bvh, Some(env), &integrator, count, cancel))
     }
 
-    fn image(&self) -> Vec<Vec3> {
+    /// The reference (the halves' mean) and its noise, from one look at each half.
+    fn reference(&self) -> (Vec<Vec3>, f64) {
         let (a, b) = (self.halves[0].image(), self.halves[1].image());
-        a.iter().zip(&b).map(|(a, b)| 0.5 * (*a + *b)).collect()
-    }
-
-    fn noise(&self) -> f64 {
-        0.5 * rmse(&self.halves[0].image(), &self.halves[1].image())
+        (a.iter().zip(&b).map(|(a, b)| 0.5 * (*a + *b)).collect(), 0.5 * rmse(&a, &b))
     }
 
     /// (RMSE, RMSE with the noise taken out, FLIP) of `frame` against `reference`.
@@ -322,7 +319,8 @@ fn refine(shared: &Shared, job: &Arc<Job>) -> Option<Option<Arc<Job>>> {
             if !run.pass(&shared.cancel) {
                 continue;
             }
-            reference = Some((Arc::new(run.image()), run.noise()));
+            let (image, noise) = run.reference();
+            reference = Some((Arc::new(image), noise));
         }
         let Some((image, noise)) = reference.clone() else { continue };
         let seconds = start.elapsed().as_secs_f64();
@@ -376,7 +374,7 @@ pub(crate) fn converge(job: &Job, frame: &[Vec3]) -> Option<Converged> {
         snapshots.push((run.halves[0].spp(), run.halves[0].seconds(), run.halves[0].image()));
     }
     let seconds = start.elapsed().as_secs_f64();
-    let (image, noise) = (run.image(), run.noise());
+    let (image, noise) = run.reference();
     let (rmse_all, rmse_truth, flip_all) = run.measure(&image, noise, frame);
     let other = run.halves[1].image();
     let (w, h) = run.halves[1].size();
